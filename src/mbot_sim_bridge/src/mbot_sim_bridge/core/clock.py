@@ -1,0 +1,46 @@
+"""Update timers on sim time, the way Gazebo's plugins pace themselves.
+
+A timer never counts calls: it compares sim time with its last firing and advances that by whole periods
+(``last += period``), so a rate holds exactly over a long run instead of drifting with the step size.
+"""
+import math
+
+# Sim time is a whole number of steps times the step size; this absorbs the rounding of that product.
+_EPSILON = 1e-9
+
+
+class UpdateTimer:
+    """Fires at ``rate`` Hz of sim time; rate ≤ 0 fires on every step.
+
+    ``strict`` copies the diff drive's ``now - last > period`` (it fires one step after each period
+    boundary); otherwise the sensors' ``now - last >= period`` applies.
+    """
+
+    def __init__(self, rate: float, strict: bool = False, start: float = 0.0):
+        self.period = 1.0 / rate if rate > 0 else 0.0
+        self.strict = strict
+        self.last = start
+
+    def reset(self, now: float):
+        self.last = now
+
+    def due(self, now: float) -> bool:
+        if self.period == 0.0:
+            return True
+        elapsed = now - self.last
+        if (elapsed > self.period + _EPSILON) if self.strict else (elapsed >= self.period - _EPSILON):
+            self.last += self.period
+            if now - self.last > self.period:
+                # Far behind (e.g. after a reset of the clock): restart from now rather than fire a burst.
+                self.last = now
+            return True
+        return False
+
+    def steps_until_due(self, now: float, step_size: float) -> int:
+        """How many more physics steps until ``due`` can be true (at least 1)."""
+        if self.period == 0.0:
+            return 1
+        remaining = self.last + self.period - now
+        steps = remaining / step_size
+        whole = math.floor(steps + _EPSILON) + 1 if self.strict else math.ceil(steps - _EPSILON)
+        return max(1, whole)

@@ -1,0 +1,271 @@
+"""PyBullet world: physics settings, spawned robots with named accessors, sim time, reset.
+
+Each Engine owns its own BulletClient (never PyBullet's module-global client), so tests can run several
+side by side. Sim time is kept as a whole number of physics steps, so it never drifts.
+"""
+import contextlib
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from .errors import ModelError
+from .geometry import IDENTITY, Pose, compose, inverse
+from .log import get_logger, warn_once
+from .robot_model import RobotModel
+from .world import PhysicsConfig
+
+_logger = get_logger(__name__)
+
+# Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
+DEFAULT_MU = 1.0
+# Collision-filter group bits handed to spawned robots, one bit each, so a robot's own sensors can skip it.
+_FIRST_ROBOT_GROUP_BIT = 4
+_LAST_ROBOT_GROUP_BIT = 30
+
+
+@contextlib.contextmanager
+def _stdout_silenced():
+    """PyBullet's URDF importer prints its link merging to the C stdout; keep that out of the node's output."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with open(os.devnull, "w") as devnull:
+        os.dup2(devnull.fileno(), 1)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+@dataclass
+class _InitialState:
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+    joint_positions: Dict[int, float]
+
+
+def root_from_com(client: BulletClient, body: int) -> Pose:
+    """PyBullet places a base at its centre of mass; this is the root link frame seen from there."""
+    inertial = client.getDynamicsInfo(body, -1)
+    return inverse(Pose(tuple(inertial[3]), tuple(inertial[4])))
+
+
+class SpawnedRobot:
+    """A URDF robot in the engine, addressed by URDF link and joint names."""
+
+    def __init__(self, client: BulletClient, name: str, model: RobotModel, body: int, namespace: str,
+                 collision_group: int):
+        self.client = client
+        self.name = name
+        self.model = model
+        self.body = body
+        self.namespace = namespace
+        self.collision_group = collision_group
+        self.link_index: Dict[str, int] = {model.root: -1}
+        self.joint_index: Dict[str, int] = {}
+        for index in range(client.getNumJoints(body)):
+            info = client.getJointInfo(body, index)
+            self.link_index[info[12].decode()] = index
+            self.joint_index[info[1].decode()] = index
+        self.root_from_com = root_from_com(client, body)
+        self.movable_joints = [joint.name for joint in model.movable_joints() if joint.name in self.joint_index]
+
+    def root_pose(self) -> Pose:
+        position, orientation = self.client.getBasePositionAndOrientation(self.body)
+        return compose(Pose(tuple(position), tuple(orientation)), self.root_from_com)
+
+    def root_velocity(self) -> Tuple[numpy.ndarray, numpy.ndarray]:
+        """World-frame (linear velocity of the root link frame's origin, angular velocity)."""
+        com_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        linear, angular = self.client.getBaseVelocity(self.body)
+        linear, angular = numpy.array(linear), numpy.array(angular)
+        offset = numpy.array(self.root_pose().position) - numpy.array(com_position)
+        return linear + numpy.cross(angular, offset), angular
+
+    def link_world_pose(self, link_name: str) -> Pose:
+        """World pose of any URDF link's frame, lumped ones included."""
+        body_link, offset = self.model.lumped_into[link_name]
+        index = self.link_index[body_link]
+        if index == -1:
+            frame = self.root_pose()
+        else:
+            state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
+            frame = Pose(tuple(state[4]), tuple(state[5]))
+        return compose(frame, offset) if offset != IDENTITY else frame
+
+    def joint_state(self, joint_names: Sequence[str]) -> List[Tuple[float, float, float]]:
+        """(position, velocity, applied effort) per named joint."""
+        states = self.client.getJointStates(self.body, [self.joint_index[name] for name in joint_names])
+        return [(state[0], state[1], state[3]) for state in states]
+
+    def set_joint_velocity(self, joint_name: str, velocity: float, max_force: float):
+        """A velocity motor, as Gazebo's ODE joint 'vel' + 'fmax' pair."""
+        self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.VELOCITY_CONTROL,
+                                          targetVelocity=velocity, force=max_force)
+
+    def release_joint(self, joint_name: str):
+        """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
+        self.set_joint_velocity(joint_name, 0.0, 0.0)
+
+
+class Engine:
+    def __init__(self, physics: PhysicsConfig = PhysicsConfig(), connection_mode: int = pybullet.DIRECT):
+        self.client = BulletClient(connection_mode=connection_mode)
+        self.physics = physics
+        self.client.setTimeStep(physics.max_step_size)
+        self.client.setGravity(*physics.gravity)
+        # Same inputs, same contacts: keeps two runs (and two tests) identical.
+        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        self.steps = 0
+        self.robots: Dict[str, SpawnedRobot] = {}
+        self.world_bodies: Dict[str, int] = {}
+        self._initial: Dict[int, _InitialState] = {}
+
+    @property
+    def sim_time(self) -> float:
+        return self.steps * self.physics.max_step_size
+
+    def step(self, count: int = 1):
+        for _ in range(count):
+            self.client.stepSimulation()
+        self.steps += count
+
+    def set_gravity(self, gravity: Sequence[float]):
+        self.physics = PhysicsConfig(self.physics.max_step_size, self.physics.real_time_factor,
+                                     self.physics.real_time_update_rate, tuple(gravity))
+        self.client.setGravity(*gravity)
+
+    def add_world_bodies(self, bodies: Dict[str, int]):
+        """Register bodies a world loader built, so reset and model queries know them."""
+        for name, body in bodies.items():
+            self.world_bodies[name] = body
+            self._remember_initial_state(body)
+
+    def model_names(self) -> List[str]:
+        return list(self.world_bodies) + list(self.robots)
+
+    def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/",
+                    driven_joints: Sequence[str] = ()) -> SpawnedRobot:
+        if name in self.robots or name in self.world_bodies:
+            raise ModelError("model '%s' already exists" % name)
+        body = self._load_urdf(model, pose)
+        robot = SpawnedRobot(self.client, name, model, body, namespace, self._free_collision_group())
+        casters = set(model.caster_links(driven_joints))
+        if casters:
+            _logger.info("%s: ball-caster contact (frictionless) for %s", name, ", ".join(sorted(casters)))
+        for link_name, index in robot.link_index.items():
+            self._set_surface(robot, link_name, index, caster=link_name in casters)
+            self.client.setCollisionFilterGroupMask(body, index, robot.collision_group, -1)
+        for joint_name in robot.movable_joints:
+            robot.release_joint(joint_name)
+        self.robots[name] = robot
+        self._remember_initial_state(body)
+        return robot
+
+    def remove(self, name: str):
+        if name in self.robots:
+            body = self.robots.pop(name).body
+        elif name in self.world_bodies:
+            body = self.world_bodies.pop(name)
+        else:
+            raise ModelError("model '%s' does not exist" % name)
+        self._initial.pop(body, None)
+        self.client.removeBody(body)
+
+    def body_of(self, name: str) -> int:
+        if name in self.robots:
+            return self.robots[name].body
+        if name in self.world_bodies:
+            return self.world_bodies[name]
+        raise ModelError("model '%s' does not exist" % name)
+
+    def model_pose(self, name: str) -> Pose:
+        if name in self.robots:
+            return self.robots[name].root_pose()
+        position, orientation = self.client.getBasePositionAndOrientation(self.body_of(name))
+        return Pose(tuple(position), tuple(orientation))
+
+    def model_velocity(self, name: str) -> Tuple[numpy.ndarray, numpy.ndarray]:
+        if name in self.robots:
+            return self.robots[name].root_velocity()
+        linear, angular = self.client.getBaseVelocity(self.body_of(name))
+        return numpy.array(linear), numpy.array(angular)
+
+    def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
+        """Move a model's frame to ``pose`` and give every link the same world velocity (as Gazebo does)."""
+        body = self.body_of(name)
+        com = compose(pose, inverse(self.robots[name].root_from_com)) if name in self.robots else pose
+        self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
+        self.client.resetBaseVelocity(body, linear, angular)
+
+    def reset_world(self):
+        """Every model back to its spawn pose and joint positions, at rest (Gazebo's reset_world)."""
+        for body, initial in self._initial.items():
+            self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
+            self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
+            for index, position in initial.joint_positions.items():
+                self.client.resetJointState(body, index, position, 0.0)
+
+    def reset_simulation(self):
+        """reset_world plus sim time back to 0 (Gazebo's reset_simulation)."""
+        self.reset_world()
+        self.steps = 0
+
+    def close(self):
+        if self.client is not None:
+            self.client.disconnect()
+            self.client = None
+
+    def _load_urdf(self, model: RobotModel, pose: Pose) -> int:
+        # PyBullet reads URDF only from a file; a private temp file keeps the source tree untouched.
+        handle, path = tempfile.mkstemp(prefix="mbot_sim_bridge_", suffix=".urdf")
+        try:
+            with os.fdopen(handle, "w") as urdf_file:
+                urdf_file.write(model.pybullet_urdf)
+            flags = (pybullet.URDF_MERGE_FIXED_LINKS | pybullet.URDF_USE_INERTIA_FROM_FILE
+                     | pybullet.URDF_USE_IMPLICIT_CYLINDER)
+            with _stdout_silenced():
+                body = self.client.loadURDF(path, flags=flags)
+        except pybullet.error as error:
+            raise ModelError("PyBullet could not load model '%s': %s" % (model.name, error)) from None
+        finally:
+            os.unlink(path)
+        com = compose(pose, inverse(root_from_com(self.client, body)))
+        self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
+        return body
+
+    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
+        link = robot.model.links.get(link_name)
+        mu = DEFAULT_MU
+        if link is not None:
+            mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
+            values = [float(v) for v in (mu1, mu2) if v is not None]
+            if len(values) == 2 and values[0] != values[1]:
+                warn_once(_logger, "%s: link '%s' has mu1 %s and mu2 %s; Bullet's friction is isotropic, the "
+                          "smaller is used" % (robot.name, link_name, mu1, mu2))
+            if values:
+                mu = min(values)
+        if caster:
+            mu = 0.0
+        self.client.changeDynamics(robot.body, index, lateralFriction=mu, spinningFriction=0.0,
+                                   rollingFriction=0.0, restitution=0.0)
+
+    def _free_collision_group(self) -> int:
+        used = {robot.collision_group for robot in self.robots.values()}
+        for bit in range(_FIRST_ROBOT_GROUP_BIT, _LAST_ROBOT_GROUP_BIT + 1):
+            if (1 << bit) not in used:
+                return 1 << bit
+        raise ModelError("too many robots: each needs a collision-filter bit and all %d are taken"
+                         % (_LAST_ROBOT_GROUP_BIT - _FIRST_ROBOT_GROUP_BIT + 1))
+
+    def _remember_initial_state(self, body: int):
+        position, orientation = self.client.getBasePositionAndOrientation(body)
+        joints = {index: self.client.getJointState(body, index)[0]
+                  for index in range(self.client.getNumJoints(body))}
+        self._initial[body] = _InitialState(tuple(position), tuple(orientation), joints)

@@ -1,0 +1,30 @@
+"""Logging for the core.
+
+Core modules log to children of the stdlib logger ``rosout``: under rospy that logger reaches the console
+and /rosout, under pytest it reaches ``caplog``. ``warn_once`` keeps a bad input from flooding the log.
+"""
+import logging
+import threading
+
+_warned = set()
+_warned_lock = threading.Lock()
+
+
+def get_logger(module_name: str) -> logging.Logger:
+    """``get_logger(__name__)`` -> ``rosout.mbot_sim_bridge.core.<module>``."""
+    return logging.getLogger("rosout." + module_name)
+
+
+def warn_once(logger: logging.Logger, message: str) -> None:
+    """Log ``message`` at WARNING the first time this exact text is seen in the process."""
+    with _warned_lock:
+        if message in _warned:
+            return
+        _warned.add(message)
+    logger.warning(message)
+
+
+def forget_warnings() -> None:
+    """Let every warning be logged again (tests use this to check a warning appears)."""
+    with _warned_lock:
+        _warned.clear()

@@ -1,0 +1,276 @@
+"""robot_description (URDF after xacro) -> what the simulator needs, the way Gazebo's URDF import sees it.
+
+Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
+- fixed joints are lumped into their parent (PyBullet does the same with URDF_MERGE_FIXED_LINKS), so each
+  URDF link maps to a simulated body link plus a fixed offset;
+- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia,
+  so it gets a negligible inertial in the URDF handed to PyBullet);
+- a link with no ``<inertial>`` on a moving joint is not simulated, together with its subtree (with a warning);
+- ``<gazebo reference="...">`` blocks are collected per link; model-level ``<gazebo>`` blocks carry plugins.
+"""
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+from xml.etree import ElementTree
+
+from .errors import ModelError
+from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
+from .log import get_logger, warn_once
+
+_logger = get_logger(__name__)
+
+MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
+# PyBullet's URDF importer knows these; planar and floating joints are not importable into a multibody.
+SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
+
+# <gazebo reference="link"> tags the bridge acts on, and those it reads but that change nothing in Bullet.
+LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor", "turnGravityOff", "gravity", "selfCollide")
+LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", "maxContacts", "dampingFactor",
+                       "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
+                       "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
+                       "preserveFixedJoint", "disableFixedJointLumping")
+# A negligible inertial for massless lumped links: PyBullet adds it to the parent, which leaves the
+# parent's mass and inertia unchanged to within rounding, as Gazebo's lumping does.
+_NEGLIGIBLE_MASS = 1e-9
+_NEGLIGIBLE_INERTIA = 1e-12
+
+
+@dataclass
+class Link:
+    name: str
+    has_inertial: bool
+    mass: float
+    collision_kinds: List[str]
+    gazebo: List[ElementTree.Element] = field(default_factory=list)
+
+    def gazebo_tag(self, tag: str) -> Optional[str]:
+        """Text of the last ``<gazebo reference>`` child with this tag (later blocks win, as in sdformat)."""
+        text = None
+        for block in self.gazebo:
+            child = block.find(tag)
+            if child is not None and child.text is not None:
+                text = child.text.strip()
+        return text
+
+
+@dataclass
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: Pose
+    axis: Tuple[float, float, float]
+
+    @property
+    def movable(self) -> bool:
+        return self.type in MOVABLE_JOINT_TYPES
+
+
+@dataclass
+class RobotModel:
+    name: str
+    root: str
+    links: Dict[str, Link]
+    joints: Dict[str, Joint]
+    plugins: List[ElementTree.Element]
+    # For every URDF link: (the simulated link it is lumped into, its pose in that link's frame).
+    lumped_into: Dict[str, Tuple[str, Pose]]
+    pybullet_urdf: str
+
+    def movable_joints(self) -> List[Joint]:
+        return [joint for joint in self.joints.values() if joint.movable]
+
+    def parent_joint(self, link_name: str) -> Optional[Joint]:
+        for joint in self.joints.values():
+            if joint.child == link_name:
+                return joint
+        return None
+
+    def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
+        """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
+        return [(link.name, sensor) for link in self.links.values()
+                for block in link.gazebo for sensor in block.findall("sensor")]
+
+    def caster_links(self, driven_joints) -> List[str]:
+        """Links that act as ball casters: every collision a sphere, on a joint nothing drives.
+
+        Gazebo users rely on ODE letting such a sphere slide sideways. In Bullet, a sphere on a one-axis
+        joint (the course's back caster) rolls only forwards and its sideways friction pins the robot when
+        it turns in place, so these links get frictionless contacts unless their <gazebo> block sets mu1/mu2.
+        """
+        casters = []
+        for joint in self.joints.values():
+            link = self.links[joint.child]
+            if (joint.name not in driven_joints and link.collision_kinds
+                    and all(kind == "sphere" for kind in link.collision_kinds)
+                    and link.gazebo_tag("mu1") is None and link.gazebo_tag("mu2") is None):
+                casters.append(link.name)
+        return casters
+
+
+def _floats(text: Optional[str], count: int, default: float, where: str) -> Tuple[float, ...]:
+    if text is None:
+        return (default,) * count
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        raise ModelError("%s: expected %d numbers, got '%s'" % (where, count, text)) from None
+    if len(values) != count:
+        raise ModelError("%s: expected %d numbers, got '%s'" % (where, count, text))
+    return values
+
+
+def _origin(element: ElementTree.Element, where: str) -> Pose:
+    origin = element.find("origin")
+    if origin is None:
+        return IDENTITY
+    return pose_from_xyz_rpy(_floats(origin.get("xyz"), 3, 0.0, where + " <origin xyz>"),
+                             _floats(origin.get("rpy"), 3, 0.0, where + " <origin rpy>"))
+
+
+def _parse_xml(urdf_xml: str, source: str) -> ElementTree.Element:
+    if not urdf_xml or not urdf_xml.strip():
+        raise ModelError("%s is empty" % source)
+    try:
+        root = ElementTree.fromstring(urdf_xml)
+    except ElementTree.ParseError as error:
+        raise ModelError("%s is not valid XML: %s" % (source, error)) from None
+    if root.tag != "robot":
+        raise ModelError("%s is not URDF: its root element is <%s>, not <robot>" % (source, root.tag))
+    return root
+
+
+def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
+    """Parse and check a URDF string; ``source`` names it in every error ("robot_description", a file)."""
+    root = _parse_xml(urdf_xml, source)
+    name = root.get("name") or "robot"
+    links: Dict[str, Link] = {}
+    for element in root.findall("link"):
+        link_name = element.get("name")
+        if not link_name:
+            raise ModelError("%s: a <link> has no name" % source)
+        inertial = element.find("inertial")
+        mass = 0.0
+        if inertial is not None and inertial.find("mass") is not None:
+            mass = _floats(inertial.find("mass").get("value"), 1, 0.0, "%s link '%s' <mass>" % (source, link_name))[0]
+        kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
+                 if geometry is not None and len(geometry)]
+        links[link_name] = Link(link_name, inertial is not None and mass > 0, mass, kinds)
+    if not links:
+        raise ModelError("%s: the robot has no <link>" % source)
+
+    joints: Dict[str, Joint] = {}
+    for element in root.findall("joint"):
+        joint_name = element.get("name")
+        where = "%s joint '%s'" % (source, joint_name)
+        joint_type = element.get("type")
+        if joint_type not in SUPPORTED_JOINT_TYPES:
+            raise ModelError("%s: type '%s' is not supported; use one of %s"
+                             % (where, joint_type, ", ".join(SUPPORTED_JOINT_TYPES)))
+        parent, child = element.find("parent"), element.find("child")
+        if parent is None or child is None:
+            raise ModelError("%s: needs <parent link> and <child link>" % where)
+        for role, link_name in (("parent", parent.get("link")), ("child", child.get("link"))):
+            if link_name not in links:
+                raise ModelError("%s: %s link '%s' is not defined" % (where, role, link_name))
+        axis = element.find("axis")
+        joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
+                                   _origin(element, where),
+                                   _floats(axis.get("xyz") if axis is not None else None, 3, 0.0, where + " <axis>")
+                                   if axis is not None else (1.0, 0.0, 0.0))
+
+    children = {joint.child for joint in joints.values()}
+    roots = [link_name for link_name in links if link_name not in children]
+    if len(roots) != 1:
+        raise ModelError("%s: expected one root link, found %s" % (source, ", ".join(roots) or "none (a loop)"))
+
+    plugins = _collect_gazebo_blocks(root, links, joints, source)
+    dropped = _drop_massless_moving_links(links, joints, source)
+    lumped_into = _lump_fixed_links(roots[0], links, joints)
+    return RobotModel(name, roots[0], links, joints, plugins, lumped_into,
+                      _pybullet_urdf(root, links, dropped))
+
+
+def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:
+    plugins = []
+    for block in root.findall("gazebo"):
+        reference = block.get("reference")
+        if reference is None:
+            for child in block:
+                if child.tag == "plugin":
+                    plugins.append(child)
+                elif isinstance(child.tag, str) and child.tag != "static":
+                    warn_once(_logger, "%s: model-level <gazebo> tag <%s> is not supported; ignored" % (source, child.tag))
+            continue
+        if reference in links:
+            links[reference].gazebo.append(block)
+            for child in block:
+                if isinstance(child.tag, str) and child.tag not in LINK_TAGS_USED + LINK_TAGS_NO_EFFECT:
+                    warn_once(_logger, "%s: <gazebo reference='%s'> tag <%s> is not supported; ignored"
+                              % (source, reference, child.tag))
+        elif reference not in joints:
+            warn_once(_logger, "%s: <gazebo reference='%s'> names no link or joint; ignored" % (source, reference))
+    return plugins
+
+
+def _subtree(link_name, joints) -> List[str]:
+    names = [link_name]
+    for joint in joints.values():
+        if joint.parent == link_name:
+            names.extend(_subtree(joint.child, joints))
+    return names
+
+
+def _drop_massless_moving_links(links, joints, source) -> List[str]:
+    """Gazebo does not model a massless link on a moving joint; it drops it with its whole subtree."""
+    dropped: List[str] = []
+    for joint in list(joints.values()):
+        if joint.name not in joints or not joint.movable or links[joint.child].has_inertial:
+            continue
+        subtree = _subtree(joint.child, joints)
+        warn_once(_logger, "%s: link '%s' has no <inertial> but moves on joint '%s'; like Gazebo, the simulation "
+                  "leaves out it and its subtree (%s)" % (source, joint.child, joint.name, ", ".join(subtree)))
+        dropped.extend(subtree)
+        for name in subtree:
+            del links[name]
+        for other in [j for j in joints.values() if j.child in subtree]:
+            del joints[other.name]
+    return dropped
+
+
+def _lump_fixed_links(root_name, links, joints) -> Dict[str, Tuple[str, Pose]]:
+    lumped = {root_name: (root_name, IDENTITY)}
+    pending = [root_name]
+    while pending:
+        parent = pending.pop()
+        body, offset = lumped[parent]
+        for joint in joints.values():
+            if joint.parent != parent:
+                continue
+            if joint.type == "fixed":
+                lumped[joint.child] = (body, compose(offset, joint.origin))
+            else:
+                lumped[joint.child] = (joint.child, IDENTITY)
+            pending.append(joint.child)
+    return lumped
+
+
+def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str]) -> str:
+    """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless."""
+    for element in list(root):
+        if element.tag in ("gazebo", "transmission"):
+            root.remove(element)
+        elif element.tag == "link" and element.get("name") in dropped:
+            root.remove(element)
+        elif element.tag == "joint" and element.find("child").get("link") in dropped:
+            root.remove(element)
+    for element in root.findall("link"):
+        if links[element.get("name")].has_inertial:
+            continue
+        for stale in element.findall("inertial"):
+            element.remove(stale)
+        inertial = ElementTree.SubElement(element, "inertial")
+        ElementTree.SubElement(inertial, "mass", value=repr(_NEGLIGIBLE_MASS))
+        ElementTree.SubElement(inertial, "inertia", ixx=repr(_NEGLIGIBLE_INERTIA), iyy=repr(_NEGLIGIBLE_INERTIA),
+                               izz=repr(_NEGLIGIBLE_INERTIA), ixy="0", ixz="0", iyz="0")
+    return ElementTree.tostring(root, encoding="unicode")

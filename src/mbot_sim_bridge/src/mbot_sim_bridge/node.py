@@ -1,0 +1,199 @@
+"""The ``gazebo`` node: one loop that owns the PyBullet engine, steps it, runs plugin updates, publishes /clock.
+
+Everything that touches the engine runs in the loop's thread; ROS callbacks (services, cmd_vel) only hand
+work or values over. The loop paces itself with time.monotonic() to follow the real-time factor: it must not
+use rospy.Rate or rospy.sleep, because under use_sim_time those wait for the /clock this loop publishes.
+"""
+import os
+import queue
+import sys
+import time
+from concurrent.futures import Future
+from typing import Callable, Dict, List, Optional
+
+import numpy
+import pybullet
+import rospkg
+import rospy
+import tf2_ros
+from rosgraph_msgs.msg import Clock
+
+from .core.clock import UpdateTimer
+from .core.engine import Engine
+from .core.errors import BridgeError, WorldError
+from .core.world import PhysicsConfig, default_model_path, load_world, parse_world
+from .plugins import BridgePlugin
+from .services import GazeboRosApi
+
+DEFAULT_CLOCK_FREQUENCY = 100.0
+# Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
+_MAX_BATCH_SIM_SECONDS = 0.01
+# How far ahead of the wall clock the loop may run before it sleeps, at a real-time factor > 0.
+_PACING_SLACK_SECONDS = 0.002
+
+
+def _bool_param(name: str, default: bool) -> bool:
+    value = rospy.get_param(name, default)
+    return value if isinstance(value, bool) else str(value).strip().lower() in ("true", "1")
+
+
+class SimBridgeNode:
+    def __init__(self):
+        # Every ~param is read here, once (teleop_twist_keyboard style), and logged once below.
+        self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
+        self.start_paused = _bool_param("~paused", False)
+        requested_gui = _bool_param("~gui", False)
+        real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
+        # Gazebo publishes /clock on every step; from Python that costs more than the step itself, so the
+        # bridge defaults to 100 Hz and also publishes right before any plugin output (see README).
+        clock_frequency = float(rospy.get_param("~pub_clock_frequency", DEFAULT_CLOCK_FREQUENCY))
+        self.joint_state_rate = float(rospy.get_param("~joint_state_rate", 100.0))
+        seed = int(rospy.get_param("~seed", 0))
+
+        world = parse_world(self.world_path, default_model_path())
+        self.physics: PhysicsConfig = world.physics
+        self.gui = requested_gui and bool(os.environ.get("DISPLAY"))
+        if requested_gui and not self.gui:
+            rospy.loginfo("gui:=true but no DISPLAY is set: running without a window")
+        self.engine = Engine(self.physics, pybullet.GUI if self.gui else pybullet.DIRECT)
+        self.world = load_world(self.engine.client, world)
+        self.engine.add_world_bodies(self.world.bodies)
+        self.real_time_factor = (float(real_time_factor) if real_time_factor
+                                 else self.physics.max_step_size * self.physics.real_time_update_rate)
+        self.paused = self.start_paused
+        self.rng = numpy.random.default_rng(seed)
+
+        self.clock_publisher = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.clock_timer = UpdateTimer(clock_frequency)
+        self.tf_broadcaster = tf2_ros.TransformBroadcaster()
+        self.api = GazeboRosApi(self)
+        self.plugins: Dict[str, List[BridgePlugin]] = {}
+        self._requests: "queue.Queue[tuple]" = queue.Queue()
+        self._pace_wall_start = self._pace_sim_start = 0.0
+        # gazebo_ros sets /use_sim_time only when nobody has.
+        if not rospy.has_param("/use_sim_time"):
+            rospy.set_param("/use_sim_time", True)
+        rospy.loginfo("world %s: step %.4f s, gravity %s, real-time factor %s, /clock %s, %s, %s",
+                      self.world_path, self.physics.max_step_size, self.physics.gravity,
+                      self.real_time_factor or "0 (as fast as possible)",
+                      "every step" if clock_frequency <= 0 else "at %.0f Hz" % clock_frequency,
+                      "paused" if self.paused else "running", "GUI" if self.gui else "headless")
+
+    # -- called from ROS threads -------------------------------------------------------------------------
+    def call_in_loop(self, function: Callable, timeout: float = 30.0):
+        """Run ``function`` in the loop's thread (the only one that touches the engine) and return its result."""
+        future: Future = Future()
+        self._requests.put((function, future))
+        return future.result(timeout)
+
+    # -- loop thread --------------------------------------------------------------------------------------
+    def stamp(self) -> rospy.Time:
+        nanoseconds = int(round(self.engine.sim_time * 1e9))
+        return rospy.Time(*divmod(nanoseconds, 1000000000))
+
+    def set_paused(self, paused: bool):
+        self.paused = paused
+        self._restart_pacing()
+
+    def reset(self, simulation: bool):
+        """reset_simulation (sim time back to 0) or reset_world (models only); plugins are reset either way."""
+        if simulation:
+            self.engine.reset_simulation()
+            self.clock_timer.reset(0.0)
+        else:
+            self.engine.reset_world()
+        for plugins in self.plugins.values():
+            for plugin in plugins:
+                plugin.reset(self.engine.sim_time)
+        self._restart_pacing()
+
+    def run(self):
+        self._restart_pacing()
+        while not rospy.is_shutdown():
+            self._serve_requests(block=self.paused)
+            if self.paused:
+                continue
+            every_step = [plugin for plugins in self.plugins.values() for plugin in plugins
+                          if plugin.needs_every_step]
+            count = 1 if every_step else self._steps_to_next_event()
+            self.engine.step(count)
+            for plugin in every_step:
+                plugin.on_step(self.physics.max_step_size)
+            self._run_due_updates()
+            self._pace()
+
+    def _steps_to_next_event(self) -> int:
+        now, step = self.engine.sim_time, self.physics.max_step_size
+        candidates = [self.clock_timer.steps_until_due(now, step)]
+        candidates.extend(plugin.timer.steps_until_due(now, step)
+                          for plugins in self.plugins.values() for plugin in plugins)
+        return max(1, min(min(candidates), int(round(_MAX_BATCH_SIM_SECONDS / step))))
+
+    def _run_due_updates(self):
+        now = self.engine.sim_time
+        due = [plugin for plugins in list(self.plugins.values()) for plugin in plugins if plugin.timer.due(now)]
+        # /clock goes first, so no message is stamped ahead of the clock its subscribers have seen.
+        if self.clock_timer.due(now) or due:
+            self.clock_publisher.publish(Clock(clock=self.stamp()))
+            self.api.publish_model_states()
+            # The timer guarantees the longest gap between two /clock messages, counted from the last one.
+            self.clock_timer.reset(now)
+        for plugin in due:
+            plugin.update(now)
+
+    def _serve_requests(self, block: bool):
+        try:
+            function, future = self._requests.get(timeout=0.1) if block else self._requests.get_nowait()
+        except queue.Empty:
+            return
+        while True:
+            if future.set_running_or_notify_cancel():
+                try:
+                    future.set_result(function())
+                except Exception as error:  # handed back to the waiting ROS thread, which reports it
+                    future.set_exception(error)
+            try:
+                function, future = self._requests.get_nowait()
+            except queue.Empty:
+                return
+
+    def _restart_pacing(self):
+        self._pace_wall_start = time.monotonic()
+        self._pace_sim_start = self.engine.sim_time
+
+    def _pace(self):
+        if self.real_time_factor <= 0:
+            return
+        target = self._pace_wall_start + (self.engine.sim_time - self._pace_sim_start) / self.real_time_factor
+        ahead = target - time.monotonic()
+        if ahead > _PACING_SLACK_SECONDS:
+            time.sleep(ahead)
+
+    def close(self):
+        for name in list(self.plugins):
+            for plugin in self.plugins.pop(name):
+                plugin.close()
+        self.engine.close()
+
+
+def _workspace_worlds() -> str:
+    """The workspace's worlds/ folder, reached as $(find mbot_gazebo)/worlds like Gazebo launch files do."""
+    try:
+        return os.path.join(rospkg.RosPack().get_path("mbot_gazebo"), "worlds")
+    except rospkg.ResourceNotFound:
+        raise WorldError("no world_name given and package mbot_gazebo (which holds worlds/empty.world) is not "
+                         "on ROS_PACKAGE_PATH; source devel/setup.bash") from None
+
+
+def main():
+    verbose = "--verbose" in rospy.myargv(sys.argv)[1:]
+    rospy.init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO)
+    try:
+        node = SimBridgeNode()
+    except BridgeError as error:
+        rospy.logfatal(str(error))
+        sys.exit(1)
+    try:
+        node.run()
+    finally:
+        node.close()

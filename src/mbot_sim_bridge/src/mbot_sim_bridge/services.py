@@ -1,0 +1,240 @@
+"""gazebo_ros's ROS API (``libgazebo_ros_api_plugin.so``): the /gazebo/* services and model_states.
+
+Handlers run in rospy's threads and hand the work to the loop thread through ``node.call_in_loop``.
+Spawning a robot also builds its plugins from the robot's own ``<gazebo>`` blocks.
+"""
+import re
+from typing import List
+from xml.etree import ElementTree
+
+import rospkg
+import rospy
+from gazebo_msgs.msg import ModelStates
+from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
+                             GetPhysicsProperties, GetPhysicsPropertiesResponse, GetWorldProperties,
+                             GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
+                             SpawnModelResponse)
+from geometry_msgs.msg import Pose as PoseMessage
+from geometry_msgs.msg import Twist
+from std_srvs.srv import Empty, EmptyResponse
+
+from .core.errors import BridgeError, ModelError
+from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
+from .core.log import get_logger, warn_once
+from .core.robot_model import parse_robot
+from .plugins import PluginContext
+from .plugins.gazebo_ros_diff_drive import GazeboRosDiffDrive
+from .plugins.model_joint_states import ModelJointStatePublisher
+
+_logger = get_logger(__name__)
+
+# Gazebo plugin file name -> the class that emulates it (one module per .so, named after it).
+MODEL_PLUGINS = {"libgazebo_ros_diff_drive.so": GazeboRosDiffDrive}
+SENSOR_PLUGINS = {}
+_WORLD_FRAMES = ("", "world", "map", "/map")
+
+
+def _pose_from_message(message: PoseMessage) -> Pose:
+    q = message.orientation
+    norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) ** 0.5
+    orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else (q.x / norm, q.y / norm, q.z / norm, q.w / norm)
+    return Pose((message.position.x, message.position.y, message.position.z), orientation)
+
+
+def _pose_to_message(pose: Pose) -> PoseMessage:
+    message = PoseMessage()
+    message.position.x, message.position.y, message.position.z = pose.position
+    (message.orientation.x, message.orientation.y, message.orientation.z,
+     message.orientation.w) = pose.orientation
+    return message
+
+
+def _twist_message(linear, angular) -> Twist:
+    twist = Twist()
+    twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
+    twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
+    return twist
+
+
+def _resolve_package_uris(xml: str) -> str:
+    """package://pkg/ -> the package's absolute path, as spawn_urdf_model does (PyBullet knows no packages)."""
+    packages = rospkg.RosPack()
+
+    def replace(match):
+        try:
+            return packages.get_path(match.group(1)) + "/"
+        except rospkg.ResourceNotFound:
+            raise ModelError("package://%s/ in the model: package '%s' not found" % (match.group(1),
+                                                                                      match.group(1))) from None
+    return re.sub(r"package://([^/]+)/", replace, xml)
+
+
+class GazeboRosApi:
+    def __init__(self, node):
+        self.node = node
+        self.model_states_publisher = rospy.Publisher("~model_states", ModelStates, queue_size=1)
+        self._services = [
+            rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
+            rospy.Service("~delete_model", DeleteModel, self._delete_model),
+            rospy.Service("~get_model_state", GetModelState, self._get_model_state),
+            rospy.Service("~set_model_state", SetModelState, self._set_model_state),
+            rospy.Service("~get_world_properties", GetWorldProperties, self._get_world_properties),
+            rospy.Service("~get_physics_properties", GetPhysicsProperties, self._get_physics_properties),
+            rospy.Service("~pause_physics", Empty, self._empty(lambda: node.set_paused(True))),
+            rospy.Service("~unpause_physics", Empty, self._empty(lambda: node.set_paused(False))),
+            rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
+            rospy.Service("~reset_world", Empty, self._empty(lambda: node.reset(simulation=False))),
+        ]
+
+    def _empty(self, action):
+        def handle(_request):
+            self.node.call_in_loop(action)
+            return EmptyResponse()
+        return handle
+
+    def _guarded(self, response_type, action):
+        """Run ``action`` in the loop thread; a BridgeError becomes success=false with its message."""
+        try:
+            return self.node.call_in_loop(action)
+        except BridgeError as error:
+            rospy.logerr(str(error))
+            return response_type(success=False, status_message=str(error))
+
+    # -- spawn and delete -------------------------------------------------------------------------------------
+    def _spawn_urdf_model(self, request):
+        def spawn():
+            name = request.model_name
+            if name in self.node.engine.model_names():
+                raise ModelError("SpawnModel: Failure - entity already exists: %s" % name)
+            model = parse_robot(_resolve_package_uris(request.model_xml), "model '%s'" % name)
+            namespace = request.robot_namespace
+            if namespace:
+                _inject_namespace(model, namespace)
+            pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+            self.spawn_robot(model, name, pose, namespace or "/")
+            return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
+        return self._guarded(SpawnModelResponse, spawn)
+
+    def spawn_robot(self, model, name, pose, namespace):
+        """Put a parsed robot in the engine with its plugins; on a plugin error, leave nothing behind."""
+        engine = self.node.engine
+        driven = [element.findtext(tag, "").strip() for element in model.plugins
+                  if element.get("filename") == "libgazebo_ros_diff_drive.so" for tag in ("leftJoint", "rightJoint")]
+        robot = engine.spawn_robot(model, name, pose, namespace, driven_joints=driven)
+        context = PluginContext(engine, robot, self.node.tf_broadcaster, self.node.stamp)
+        plugins = []
+        try:
+            for element in model.plugins:
+                plugin_class = MODEL_PLUGINS.get(element.get("filename"))
+                if plugin_class is None:
+                    warn_once(_logger, "model '%s': plugin '%s' (%s) is not emulated by the bridge; ignored"
+                              % (name, element.get("name"), element.get("filename")))
+                    continue
+                plugins.append(plugin_class(context, element))
+            for link_name, sensor in model.sensors():
+                plugins.extend(self._sensor_plugins(context, link_name, sensor))
+            published = {joint for plugin in plugins for joint in getattr(plugin, "wheel_joints", ())}
+            remaining = [joint for joint in robot.movable_joints if joint not in published]
+            if remaining:
+                plugins.append(ModelJointStatePublisher(context, remaining, self.node.joint_state_rate))
+        except BridgeError:
+            for plugin in plugins:
+                plugin.close()
+            engine.remove(name)
+            raise
+        self.node.plugins[name] = plugins
+        rospy.loginfo("spawned '%s' (%d links, %d movable joints, %d plugins) at %s", name, len(robot.link_index),
+                      len(robot.movable_joints), len(plugins), tuple(round(v, 3) for v in pose.position))
+        return robot
+
+    def _sensor_plugins(self, context, link_name, sensor: ElementTree.Element) -> List:
+        plugins = []
+        for element in sensor.findall("plugin"):
+            plugin_class = SENSOR_PLUGINS.get(element.get("filename"))
+            if plugin_class is None:
+                warn_once(_logger, "model '%s': sensor '%s' (type %s) on link '%s': plugin %s is not emulated; "
+                          "the sensor is ignored" % (context.robot.name, sensor.get("name"), sensor.get("type"),
+                                                     link_name, element.get("filename")))
+                continue
+            plugins.append(plugin_class(context, link_name, sensor, element))
+        return plugins
+
+    def _delete_model(self, request):
+        def delete():
+            for plugin in self.node.plugins.pop(request.model_name, []):
+                plugin.close()
+            self.node.engine.remove(request.model_name)
+            return DeleteModelResponse(success=True, status_message="DeleteModel: successfully deleted model")
+        return self._guarded(DeleteModelResponse, delete)
+
+    # -- state queries ---------------------------------------------------------------------------------------
+    def _reference_pose(self, frame: str) -> Pose:
+        if frame in _WORLD_FRAMES:
+            return IDENTITY
+        if frame in self.node.engine.model_names():
+            return self.node.engine.model_pose(frame)
+        raise ModelError("reference frame '%s' is neither the world nor a model" % frame)
+
+    def _get_model_state(self, request):
+        def get():
+            engine = self.node.engine
+            reference = inverse(self._reference_pose(request.relative_entity_name))
+            pose = compose(reference, engine.model_pose(request.model_name))
+            linear, angular = engine.model_velocity(request.model_name)
+            linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
+            response = GetModelStateResponse(pose=_pose_to_message(pose), twist=_twist_message(linear, angular),
+                                             success=True, status_message="GetModelState: got properties")
+            response.header.stamp = self.node.stamp()
+            response.header.frame_id = request.relative_entity_name
+            return response
+        return self._guarded(GetModelStateResponse, get)
+
+    def _set_model_state(self, request):
+        state = request.model_state
+
+        def set_state():
+            reference = self._reference_pose(state.reference_frame)
+            pose = compose(reference, _pose_from_message(state.pose))
+            twist = state.twist
+            linear = rotate(reference.orientation, (twist.linear.x, twist.linear.y, twist.linear.z))
+            angular = rotate(reference.orientation, (twist.angular.x, twist.angular.y, twist.angular.z))
+            self.node.engine.set_model_state(state.model_name, pose, linear, angular)
+            return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
+        return self._guarded(SetModelStateResponse, set_state)
+
+    def _get_world_properties(self, _request):
+        def get():
+            return GetWorldPropertiesResponse(sim_time=self.node.engine.sim_time,
+                                              model_names=self.node.engine.model_names(),
+                                              rendering_enabled=True, success=True, status_message="")
+        return self._guarded(GetWorldPropertiesResponse, get)
+
+    def _get_physics_properties(self, _request):
+        def get():
+            physics = self.node.engine.physics
+            response = GetPhysicsPropertiesResponse(time_step=physics.max_step_size, pause=self.node.paused,
+                                                    max_update_rate=physics.real_time_update_rate,
+                                                    success=True, status_message="")
+            response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
+            return response
+        return self._guarded(GetPhysicsPropertiesResponse, get)
+
+    def publish_model_states(self):
+        """Model-frame world poses and world twists, only while someone listens (as gazebo_ros)."""
+        if self.model_states_publisher.get_num_connections() == 0:
+            return
+        engine = self.node.engine
+        message = ModelStates()
+        for name in engine.model_names():
+            message.name.append(name)
+            message.pose.append(_pose_to_message(engine.model_pose(name)))
+            message.twist.append(_twist_message(*engine.model_velocity(name)))
+        self.model_states_publisher.publish(message)
+
+
+def _inject_namespace(model, namespace: str):
+    """spawn_urdf_model adds <robotNamespace> to every plugin that lacks one, sensor plugins included."""
+    sensor_plugins = [plugin for _, sensor in model.sensors() for plugin in sensor.findall("plugin")]
+    for element in model.plugins + sensor_plugins:
+        if element.find("robotNamespace") is None:
+            ElementTree.SubElement(element, "robotNamespace").text = namespace

@@ -1,0 +1,137 @@
+"""gazebo_ros's ``spawn_model`` command line, talking to the bridge's /gazebo/spawn_*_model services.
+
+Exits 1 with one line naming the problem (missing file or parameter, invalid XML, a refused spawn) where
+gazebo_ros's script would print a traceback.
+"""
+import argparse
+import sys
+from xml.etree import ElementTree
+
+import rospy
+from gazebo_msgs.srv import DeleteModel, SpawnModel
+from geometry_msgs.msg import Pose
+from std_srvs.srv import Empty
+
+from .core.geometry import pose_from_xyz_rpy
+
+
+class SpawnError(Exception):
+    pass
+
+
+def parse_arguments(argv):
+    parser = argparse.ArgumentParser(prog="spawn_model", description="Spawn a model in the simulator "
+                                     "(gazebo_ros's spawn_model command line).")
+    kind = parser.add_mutually_exclusive_group(required=True)
+    kind.add_argument("-urdf", action="store_true", help="the model is URDF")
+    kind.add_argument("-sdf", action="store_true", help="the model is SDF")
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("-file", metavar="FILE", help="read the model from FILE")
+    source.add_argument("-param", metavar="PARAM", help="read the model from ROS parameter PARAM")
+    source.add_argument("-stdin", action="store_true", help="read the model from standard input")
+    source.add_argument("-database", metavar="NAME", help="the model://NAME model (SDF)")
+    parser.add_argument("-model", required=True, metavar="NAME", help="name of the model in the simulator")
+    for axis in ("x", "y", "z", "R", "P", "Y"):
+        parser.add_argument("-" + axis, type=float, default=0.0, help="initial %s (m or rad)" % axis)
+    parser.add_argument("-J", nargs=2, action="append", metavar=("JOINT", "POSITION"), default=[],
+                        help="not supported by the bridge (refused with an error)")
+    parser.add_argument("-reference_frame", default="", help="pose relative to this model ('' = world)")
+    parser.add_argument("-robot_namespace", default=None, help="namespace injected into the model's plugins "
+                        "(default: this node's namespace)")
+    parser.add_argument("-gazebo_namespace", default="/gazebo", help="namespace of the simulator's services")
+    parser.add_argument("-unpause", action="store_true", help="unpause physics after spawning")
+    parser.add_argument("-wait", metavar="MODEL", help="wait until MODEL exists before spawning")
+    parser.add_argument("-package_to_model", action="store_true",
+                        help="accepted for compatibility: the bridge resolves package:// URIs itself")
+    parser.add_argument("-b", dest="bond", action="store_true", help="delete the model when this node stops")
+    arguments = parser.parse_args(argv)
+    if arguments.J:
+        parser.error("-J (set_model_configuration) is not supported by the bridge")
+    return arguments
+
+
+def read_model_xml(arguments) -> str:
+    if arguments.database:
+        return ("<sdf version='1.6'><world name='default'><include><uri>model://%s</uri></include></world></sdf>"
+                % arguments.database)
+    if arguments.file:
+        try:
+            with open(arguments.file) as model_file:
+                xml = model_file.read()
+        except OSError as error:
+            raise SpawnError("cannot read model file %s: %s" % (arguments.file, error.strerror)) from None
+        where = "model file %s" % arguments.file
+    elif arguments.param:
+        if not rospy.has_param(arguments.param):
+            raise SpawnError("parameter %s is not set (load the robot_description first)"
+                             % rospy.resolve_name(arguments.param))
+        xml = str(rospy.get_param(arguments.param))
+        where = "parameter %s" % rospy.resolve_name(arguments.param)
+    else:
+        xml = sys.stdin.read()
+        where = "standard input"
+    if not xml.strip():
+        raise SpawnError("%s is empty" % where)
+    try:
+        # Parsed and re-serialised as gazebo_ros does: drops the XML declaration and comments.
+        return ElementTree.tostring(ElementTree.fromstring(xml), encoding="unicode")
+    except ElementTree.ParseError as error:
+        raise SpawnError("%s is not valid XML: %s" % (where, error)) from None
+
+
+def initial_pose(arguments) -> Pose:
+    pose = pose_from_xyz_rpy((arguments.x, arguments.y, arguments.z), (arguments.R, arguments.P, arguments.Y))
+    message = Pose()
+    message.position.x, message.position.y, message.position.z = pose.position
+    q = pose.orientation
+    message.orientation.x, message.orientation.y, message.orientation.z, message.orientation.w = q
+    return message
+
+
+def wait_for_model(arguments):
+    from gazebo_msgs.msg import ModelStates
+    rospy.loginfo("waiting for model %s", arguments.wait)
+    while not rospy.is_shutdown():
+        try:
+            states = rospy.wait_for_message(arguments.gazebo_namespace + "/model_states", ModelStates, timeout=1.0)
+        except rospy.ROSException:
+            continue
+        if arguments.wait in states.name:
+            return
+
+
+def spawn(arguments):
+    service_name = "%s/spawn_%s_model" % (arguments.gazebo_namespace, "urdf" if arguments.urdf else "sdf")
+    model_xml = read_model_xml(arguments)
+    if arguments.wait:
+        wait_for_model(arguments)
+    rospy.loginfo("waiting for service %s", service_name)
+    rospy.wait_for_service(service_name)
+    namespace = arguments.robot_namespace if arguments.robot_namespace is not None else rospy.get_namespace()
+    response = rospy.ServiceProxy(service_name, SpawnModel)(arguments.model, model_xml, namespace,
+                                                            initial_pose(arguments), arguments.reference_frame)
+    if not response.success:
+        raise SpawnError("spawning '%s' failed: %s" % (arguments.model, response.status_message))
+    rospy.loginfo("spawned '%s': %s", arguments.model, response.status_message)
+    if arguments.unpause:
+        rospy.ServiceProxy(arguments.gazebo_namespace + "/unpause_physics", Empty)()
+
+
+def main():
+    arguments = parse_arguments(rospy.myargv(sys.argv)[1:])
+    rospy.init_node("spawn_model", anonymous=True)
+    try:
+        spawn(arguments)
+    except (SpawnError, rospy.ServiceException) as error:
+        print("spawn_model: %s" % error, file=sys.stderr)
+        sys.exit(1)
+    except rospy.ROSInterruptException:
+        sys.exit(1)
+    if arguments.bond:
+        def delete_model():
+            try:
+                rospy.ServiceProxy(arguments.gazebo_namespace + "/delete_model", DeleteModel)(arguments.model)
+            except (rospy.ServiceException, rospy.ROSException) as error:
+                print("spawn_model: could not delete '%s' on exit: %s" % (arguments.model, error), file=sys.stderr)
+        rospy.on_shutdown(delete_model)
+        rospy.spin()
