@@ -24,13 +24,14 @@ from .core.log import get_logger, warn_once
 from .core.robot_model import parse_robot
 from .plugins import PluginContext
 from .plugins.gazebo_ros_diff_drive import GazeboRosDiffDrive
+from .plugins.gazebo_ros_laser import GazeboRosLaser
 from .plugins.model_joint_states import ModelJointStatePublisher
 
 _logger = get_logger(__name__)
 
 # Gazebo plugin file name -> the class that emulates it (one module per .so, named after it).
 MODEL_PLUGINS = {"libgazebo_ros_diff_drive.so": GazeboRosDiffDrive}
-SENSOR_PLUGINS = {}
+SENSOR_PLUGINS = {"libgazebo_ros_laser.so": GazeboRosLaser, "libgazebo_ros_gpu_laser.so": GazeboRosLaser}
 _WORLD_FRAMES = ("", "world", "map", "/map")
 
 
@@ -149,6 +150,9 @@ class GazeboRosApi:
 
     def _sensor_plugins(self, context, link_name, sensor: ElementTree.Element) -> List:
         plugins = []
+        if not sensor.findall("plugin"):
+            warn_once(_logger, "model '%s': sensor '%s' on link '%s' has no ROS plugin; nothing is published for it"
+                      % (context.robot.name, sensor.get("name"), link_name))
         for element in sensor.findall("plugin"):
             plugin_class = SENSOR_PLUGINS.get(element.get("filename"))
             if plugin_class is None:
@@ -156,7 +160,7 @@ class GazeboRosApi:
                           "the sensor is ignored" % (context.robot.name, sensor.get("name"), sensor.get("type"),
                                                      link_name, element.get("filename")))
                 continue
-            plugins.append(plugin_class(context, link_name, sensor, element))
+            plugins.append(plugin_class(context, link_name, sensor, element, self.node.rng))
         return plugins
 
     def _delete_model(self, request):

@@ -1,0 +1,27 @@
+"""Fixtures for the core's unit tests: no ROS master, PyBullet in DIRECT mode."""
+import os
+
+import pytest
+
+WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+
+
+def expand_xacro(relative_path: str) -> str:
+    """Run the real xacro on a file of mbot_description, as robot_description would hold it."""
+    os.environ["ROS_PACKAGE_PATH"] = WORKSPACE_SRC + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
+    import xacro
+    return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path)).toxml()
+
+
+@pytest.fixture(scope="session")
+def mbot_urdf() -> str:
+    """The course's Gazebo mbot (mbot_gazebo.xacro), unchanged."""
+    return expand_xacro("urdf/gazebo/mbot_gazebo.xacro")
+
+
+@pytest.fixture(autouse=True)
+def fresh_warnings():
+    """Each test sees its own once-only warnings."""
+    from mbot_sim_bridge.core.log import forget_warnings
+    forget_warnings()
+    yield

@@ -1,0 +1,94 @@
+import logging
+
+import pytest
+
+from mbot_sim_bridge.core.errors import ModelError
+from mbot_sim_bridge.core.robot_model import parse_robot
+
+LINK = '<link name="{name}">{inertial}<collision><geometry>{geometry}</geometry></collision></link>'
+INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+
+
+def robot(*parts, name="probe"):
+    return '<robot name="%s">%s</robot>' % (name, "".join(parts))
+
+
+def link(name, geometry='<box size="0.1 0.1 0.1"/>', inertial=INERTIAL):
+    return LINK.format(name=name, geometry=geometry, inertial=inertial)
+
+
+def joint(name, kind, parent, child, xyz="0 0 0"):
+    return ('<joint name="%s" type="%s"><parent link="%s"/><child link="%s"/><origin xyz="%s"/>'
+            '<axis xyz="0 1 0"/></joint>' % (name, kind, parent, child, xyz))
+
+
+def test_course_mbot_lumps_fixed_links_like_gazebo(mbot_urdf):
+    model = parse_robot(mbot_urdf)
+    assert model.name == "mbot" and model.root == "base_footprint"
+    body, offset = model.lumped_into["base_link"]
+    assert body == "base_footprint"
+    assert offset.position == pytest.approx((0.0, 0.0, 0.005 / 2 + 0.01975 * 2))
+    assert [j.name for j in model.movable_joints()] == ["back_caster_joint", "left_wheel_joint", "right_wheel_joint"]
+    assert [p.get("filename") for p in model.plugins] == ["libgazebo_ros_diff_drive.so"]
+
+
+def test_massless_root_gets_a_negligible_inertial_for_pybullet(mbot_urdf):
+    model = parse_robot(mbot_urdf)
+    assert not model.links["base_footprint"].has_inertial
+    assert '<mass value="1e-09"' in model.pybullet_urdf
+    assert "<gazebo" not in model.pybullet_urdf and "<transmission" not in model.pybullet_urdf
+
+
+def test_caster_detection_is_by_shape_and_joint_not_by_name(mbot_urdf):
+    assert parse_robot(mbot_urdf).caster_links({"left_wheel_joint", "right_wheel_joint"}) == ["back_caster_link"]
+    urdf = robot(link("chassis"), link("front_ball", '<sphere radius="0.02"/>'), link("wheel", '<cylinder radius="0.03" length="0.02"/>'),
+                 joint("ball_mount", "fixed", "chassis", "front_ball"), joint("axle", "continuous", "chassis", "wheel"))
+    assert parse_robot(urdf).caster_links({"axle"}) == ["front_ball"]
+
+
+def test_explicit_friction_keeps_a_sphere_from_being_treated_as_a_caster():
+    urdf = robot(link("chassis"), link("ball", '<sphere radius="0.02"/>'), joint("mount", "continuous", "chassis", "ball"),
+                 '<gazebo reference="ball"><mu1>0.3</mu1><mu2>0.3</mu2></gazebo>')
+    assert parse_robot(urdf).caster_links(set()) == []
+
+
+def test_massless_link_on_a_moving_joint_is_dropped_with_its_subtree(caplog):
+    urdf = robot(link("chassis"), link("arm", inertial=""), link("hand"),
+                 joint("shoulder", "revolute", "chassis", "arm"), joint("wrist", "fixed", "arm", "hand"))
+    with caplog.at_level(logging.WARNING):
+        model = parse_robot(urdf)
+    assert set(model.links) == {"chassis"} and not model.joints
+    assert any("link 'arm' has no <inertial> but moves on joint 'shoulder'" in r.getMessage() and "arm, hand"
+               in r.getMessage() for r in caplog.records)
+
+
+def test_sensor_blocks_are_collected_per_link():
+    urdf = robot(link("chassis"), '<gazebo reference="chassis"><sensor type="ray" name="scanner"/></gazebo>')
+    assert [(name, sensor.get("name")) for name, sensor in parse_robot(urdf).sensors()] == [("chassis", "scanner")]
+
+
+def test_unknown_gazebo_tags_warn_once_and_name_the_tag(caplog):
+    urdf = robot(link("chassis"), '<gazebo reference="chassis"><sparkle>yes</sparkle></gazebo>',
+                 '<gazebo><teleporter/></gazebo>', '<gazebo reference="nowhere"><mu1>1</mu1></gazebo>')
+    with caplog.at_level(logging.WARNING):
+        parse_robot(urdf)
+    text = "\n".join(r.getMessage() for r in caplog.records)
+    assert "<gazebo reference='chassis'> tag <sparkle> is not supported" in text
+    assert "model-level <gazebo> tag <teleporter> is not supported" in text
+    assert "<gazebo reference='nowhere'> names no link or joint" in text
+
+
+@pytest.mark.parametrize("xml, message", [
+    ("", "robot_description is empty"),
+    ("<robot name='a'><link name='x'>", "robot_description is not valid XML"),
+    ("<sdf version='1.6'/>", "its root element is <sdf>, not <robot>"),
+    ("<robot name='a'/>", "the robot has no <link>"),
+    (robot(link("a"), joint("j", "continuous", "a", "b")), "joint 'j': child link 'b' is not defined"),
+    (robot(link("a"), link("b"), joint("j", "planar", "a", "b")), "joint 'j': type 'planar' is not supported"),
+    (robot(link("a"), link("b")), "expected one root link, found a, b"),
+    (robot(link("a"), link("b"), joint("j", "fixed", "a", "b", xyz="0 zero 0")), "expected 3 numbers, got '0 zero 0'"),
+])
+def test_bad_urdf_gives_one_line_errors(xml, message):
+    with pytest.raises(ModelError) as error:
+        parse_robot(xml)
+    assert message in str(error.value) and "\n" not in str(error.value)

@@ -1,0 +1,80 @@
+"""Bad input gets one clear line naming what is wrong, and no traceback."""
+import os
+
+import pytest
+
+from conftest import TESTS, run
+
+BAD_DRIVE = """<robot name="lopsided">
+  <link name="chassis"><inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/>
+    </inertial><collision><geometry><box size="0.3 0.2 0.05"/></geometry></collision></link>
+  <gazebo><plugin name="drive" filename="libgazebo_ros_diff_drive.so">
+    <leftJoint>left_wheel_joint</leftJoint><rightJoint>right_wheel_joint</rightJoint></plugin></gazebo>
+</robot>"""
+
+
+def one_error_line(output, *expected):
+    assert "Traceback" not in output, output
+    lines = [line for line in output.splitlines() if all(text in line for text in expected)]
+    assert lines, "no line containing %s in:\n%s" % (expected, output)
+
+
+def spawn(ros_env, *arguments):
+    return run(["rosrun", "mbot_sim_bridge", "spawn_model", "-urdf", "-model", "probe", *arguments], ros_env)
+
+
+def test_spawn_without_robot_description(ros_env):
+    result = spawn(ros_env, "-param", "robot_description")
+    assert result.returncode == 1
+    one_error_line(result.stderr, "spawn_model:", "parameter /robot_description is not set")
+
+
+def test_spawn_from_a_file_that_is_not_xml(ros_env, tmp_path):
+    broken = tmp_path / "broken.urdf"
+    broken.write_text("<robot name='x'><link name='a'>")
+    result = spawn(ros_env, "-file", str(broken))
+    assert result.returncode == 1
+    one_error_line(result.stderr, "spawn_model:", str(broken), "is not valid XML")
+
+
+def test_spawn_from_a_missing_file(ros_env):
+    result = spawn(ros_env, "-file", "/nonexistent/robot.urdf")
+    assert result.returncode == 1
+    one_error_line(result.stderr, "cannot read model file /nonexistent/robot.urdf")
+
+
+@pytest.fixture
+def bridge(launch):
+    return launch("mbot_sim_bridge", "empty_world.launch", "gui:=false")
+
+
+@pytest.mark.parametrize("xml, expected", [
+    ("<sdf version='1.6'><model name='m'/></sdf>", "its root element is <sdf>, not <robot>"),
+    ("<robot name='x'><link name='a'/><joint name='j' type='fixed'><parent link='a'/><child link='b'/></joint>"
+     "</robot>", "joint 'j': child link 'b' is not defined"),
+    (BAD_DRIVE, "<leftJoint> names joint 'left_wheel_joint', which the robot does not have"),
+])
+def test_spawn_refused_by_the_simulator_names_the_problem(ros_env, bridge, tmp_path, xml, expected):
+    model = tmp_path / "model.urdf"
+    model.write_text(xml)
+    result = spawn(ros_env, "-file", str(model))
+    assert result.returncode == 1, result.stderr
+    one_error_line(result.stderr, "spawn_model: spawning 'probe' failed:", expected)
+    # The simulator carries on: a good model spawns afterwards.
+    good = tmp_path / "good.urdf"
+    good.write_text("<robot name='ok'><link name='a'/></robot>")
+    assert spawn(ros_env, "-file", str(good)).returncode == 0
+
+
+def test_bridge_with_a_missing_world_exits_with_one_line(ros_env):
+    result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
+                  "world_name:=/nonexistent/nowhere.world", "server_required:=true"], ros_env)
+    one_error_line(result.stdout + result.stderr, "[FATAL]", "/nonexistent/nowhere.world")
+
+
+def test_bridge_with_malformed_world_names_file_and_line(ros_env, tmp_path):
+    world = tmp_path / "broken.world"
+    world.write_text("<?xml version='1.0'?>\n<sdf version='1.6'>\n<world name='w'>\n</sdf>\n")
+    result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
+                  "world_name:=%s" % world, "server_required:=true"], ros_env)
+    one_error_line(result.stdout + result.stderr, "[FATAL]", "broken.world:4")

@@ -1,0 +1,70 @@
+"""Helpers shared by the rostest nodes: waiting on conditions, ground truth, driving through /cmd_vel."""
+import math
+import time
+
+import rospy
+from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from geometry_msgs.msg import Twist
+from std_srvs.srv import Empty
+
+# Wall-clock limits: generous, because CI machines are slow; a test fails only if a condition never comes.
+WALL_TIMEOUT = 60.0
+
+
+def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
+    """Poll ``condition`` until it is true or ``timeout`` wall seconds pass (then AssertionError)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.01)
+    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
+
+
+def yaw_of(orientation):
+    q = orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def roll_pitch_of(orientation):
+    q = orientation
+    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
+    return roll, pitch
+
+
+class Simulator:
+    """The bridge seen through gazebo_ros's services, and the robot through /cmd_vel."""
+
+    def __init__(self, model="mbot"):
+        self.model = model
+        for service in ("get_model_state", "get_world_properties", "reset_world", "pause_physics",
+                        "unpause_physics", "reset_simulation"):
+            rospy.wait_for_service("/gazebo/" + service, timeout=WALL_TIMEOUT)
+        self.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        self.world_properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
+        self.reset_world = rospy.ServiceProxy("/gazebo/reset_world", Empty)
+        self.reset_simulation = rospy.ServiceProxy("/gazebo/reset_simulation", Empty)
+        self.pause = rospy.ServiceProxy("/gazebo/pause_physics", Empty)
+        self.unpause = rospy.ServiceProxy("/gazebo/unpause_physics", Empty)
+        wait_for(lambda: model in self.world_properties().model_names, what="model '%s' to be spawned" % model)
+        self.cmd_vel = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
+        wait_for(lambda: self.cmd_vel.get_num_connections() > 0, what="the simulator to subscribe /cmd_vel")
+
+    def truth(self):
+        """(sim time, pose, twist) of the model, measured in one step of the simulator."""
+        state = self.get_model_state(self.model, "world")
+        assert state.success, state.status_message
+        return state.header.stamp.to_sec(), state.pose, state.twist
+
+    def command(self, linear=0.0, angular=0.0):
+        twist = Twist()
+        twist.linear.x, twist.angular.z = linear, angular
+        self.cmd_vel.publish(twist)
+
+    def wait_sim_time(self, seconds):
+        """Wait until ``seconds`` of sim time have passed; returns the ground truth then."""
+        start = self.truth()[0]
+        return wait_for(lambda: (lambda truth: truth if truth[0] >= start + seconds else None)(self.truth()),
+                        what="%.1f s of sim time" % seconds)

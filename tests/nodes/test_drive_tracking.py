@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""The course's mbot, its xacro unchanged, drives as it does in Gazebo: speeds, turning, staying level, odom.
+
+Prints the measured figures; each is checked against the tolerance of the workspace's acceptance list.
+"""
+import math
+import sys
+import unittest
+
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Log
+
+from sim_support import Simulator, roll_pitch_of, wait_for, yaw_of
+
+SETTLE_SECONDS = 2.0  # a steady command for this long before measuring
+MEASURE_SECONDS = 1.0
+
+
+class DriveTracking(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("drive_tracking_test")
+        cls.sim = Simulator()
+        cls.figures = []
+
+    @classmethod
+    def tearDownClass(cls):
+        print("\n".join(["", "tracking figures (ground truth, %.0f s after the command, over %.0f s):"
+                         % (SETTLE_SECONDS, MEASURE_SECONDS)] + cls.figures), file=sys.stderr)
+
+    def steady_motion(self, linear, angular):
+        """Reset, command, settle, then measure over a window: (speed along heading, yaw rate, worst tilt, z)."""
+        self.sim.reset_world()
+        self.sim.command(linear, angular)
+        t0, pose0, _ = self.sim.wait_sim_time(SETTLE_SECONDS)
+        t1, pose1, _ = self.sim.wait_sim_time(MEASURE_SECONDS)
+        dt = t1 - t0
+        heading = yaw_of(pose0.orientation)
+        dx, dy = pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y
+        speed = (dx * math.cos(heading) + dy * math.sin(heading)) / dt
+        yaw_rate = math.remainder(yaw_of(pose1.orientation) - heading, 2 * math.pi) / dt
+        tilt = max(abs(a) for pose in (pose0, pose1) for a in roll_pitch_of(pose.orientation))
+        z = max(abs(pose0.position.z), abs(pose1.position.z))
+        self.sim.command(0.0, 0.0)
+        return speed, yaw_rate, tilt, z
+
+    def check_level(self, tilt, z):
+        self.assertLess(z, 0.01, "the robot left the ground: |z| = %.4f m" % z)
+        self.assertLess(math.degrees(tilt), 2.0, "the robot tilted %.2f degrees" % math.degrees(tilt))
+
+    def test_linear_speed_tracks_the_command(self):
+        for linear in (0.1, 0.2, 0.5, -0.2):
+            speed, yaw_rate, tilt, z = self.steady_motion(linear, 0.0)
+            self.figures.append("  v=%+.2f m/s: measured %+.4f m/s (%+.2f%%), yaw rate %+.4f rad/s, tilt %.3f deg, "
+                                "|z| %.4f m" % (linear, speed, 100 * (speed - linear) / abs(linear), yaw_rate,
+                                                math.degrees(tilt), z))
+            self.assertAlmostEqual(speed, linear, delta=0.05 * abs(linear), msg="v=%.2f" % linear)
+            self.check_level(tilt, z)
+
+    def test_turning_in_place_tracks_the_command_counter_clockwise_positive(self):
+        for angular in (0.5, 1.0, -1.0):
+            speed, yaw_rate, tilt, z = self.steady_motion(0.0, angular)
+            self.figures.append("  w=%+.2f rad/s: measured %+.4f rad/s (%+.2f%%), tilt %.3f deg, |z| %.4f m"
+                                % (angular, yaw_rate, 100 * (yaw_rate - angular) / abs(angular),
+                                   math.degrees(tilt), z))
+            # Within 5% also fixes the sign: positive angular.z turns counter-clockwise (yaw grows).
+            self.assertAlmostEqual(yaw_rate, angular, delta=0.05 * abs(angular), msg="w=%.2f" % angular)
+            self.check_level(tilt, z)
+
+    def test_odometry_agrees_with_ground_truth_after_five_metres(self):
+        self.sim.reset_world()
+        self.sim.command(0.5, 0.0)
+        wait_for(lambda: math.hypot(self.sim.truth()[1].position.x, self.sim.truth()[1].position.y) >= 5.0,
+                 what="a 5 m drive")
+        self.sim.command(0.0, 0.0)
+        self.sim.wait_sim_time(1.0)
+        _, pose, _ = self.sim.truth()
+        odometry = rospy.wait_for_message("/odom", Odometry, timeout=30.0)
+        error = math.hypot(odometry.pose.pose.position.x - pose.position.x,
+                           odometry.pose.pose.position.y - pose.position.y)
+        self.figures.append("  after a %.3f m drive: |odom - ground truth| = %.5f m"
+                            % (math.hypot(pose.position.x, pose.position.y), error))
+        self.assertLess(error, 0.01)
+        self.assertEqual((odometry.header.frame_id, odometry.child_frame_id), ("odom", "base_footprint"))
+
+    def test_non_finite_command_is_ignored_with_a_warning(self):
+        warnings = []
+        subscriber = rospy.Subscriber("/rosout", Log, lambda log: warnings.append(log.msg)
+                                      if log.level == Log.WARN and "non-finite" in log.msg else None)
+        self.sim.reset_world()
+        self.sim.command(0.2, 0.0)
+        self.sim.wait_sim_time(SETTLE_SECONDS)
+        self.sim.command(float("nan"), 0.0)
+        self.sim.command(0.0, float("inf"))
+        t0, pose0, _ = self.sim.wait_sim_time(0.5)
+        t1, pose1, _ = self.sim.wait_sim_time(MEASURE_SECONDS)
+        speed = (pose1.position.x - pose0.position.x) / (t1 - t0)
+        self.assertAlmostEqual(speed, 0.2, delta=0.01, msg="the last valid command must stay in force")
+        wait_for(lambda: warnings, timeout=10.0, what="a warning about the non-finite cmd_vel")
+        self.assertIn("/cmd_vel", warnings[0])
+        subscriber.unregister()
+        self.sim.command(0.0, 0.0)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_tests", "drive_tracking", DriveTracking)
