@@ -15,14 +15,13 @@ import numpy
 import pybullet
 import rospkg
 import rospy
-import tf2_ros
 from rosgraph_msgs.msg import Clock
 
 from .core.clock import UpdateTimer
 from .core.engine import Engine
 from .core.errors import BridgeError, WorldError
 from .core.world import PhysicsConfig, default_model_path, load_world, parse_world
-from .plugins import BridgePlugin
+from .plugins import BridgePlugin, TransformBroadcaster, loop_publisher
 from .services import GazeboRosApi
 
 DEFAULT_CLOCK_FREQUENCY = 100.0
@@ -57,15 +56,15 @@ class SimBridgeNode:
             rospy.loginfo("gui:=true but no DISPLAY is set: running without a window")
         self.engine = Engine(self.physics, pybullet.GUI if self.gui else pybullet.DIRECT)
         self.world = load_world(self.engine.client, world)
-        self.engine.add_world_bodies(self.world.bodies)
+        self.engine.add_world(self.world)
         self.real_time_factor = (float(real_time_factor) if real_time_factor
                                  else self.physics.max_step_size * self.physics.real_time_update_rate)
         self.paused = self.start_paused
         self.rng = numpy.random.default_rng(seed)
 
-        self.clock_publisher = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.clock_publisher = loop_publisher("/clock", Clock)
         self.clock_timer = UpdateTimer(clock_frequency)
-        self.tf_broadcaster = tf2_ros.TransformBroadcaster()
+        self.tf_broadcaster = TransformBroadcaster()
         self.api = GazeboRosApi(self)
         self.plugins: Dict[str, List[BridgePlugin]] = {}
         self._requests: "queue.Queue[tuple]" = queue.Queue()

@@ -4,6 +4,7 @@ Handlers run in rospy's threads and hand the work to the loop thread through ``n
 Spawning a robot also builds its plugins from the robot's own ``<gazebo>`` blocks.
 """
 import re
+import tempfile
 from typing import List
 from xml.etree import ElementTree
 
@@ -22,7 +23,9 @@ from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .core.log import get_logger, warn_once
 from .core.robot_model import parse_robot
-from .plugins import PluginContext
+from .core.sdf_spawn import spawn_world_xml
+from .core.world import default_model_path, load_world, parse_world
+from .plugins import PluginContext, loop_publisher
 from .plugins.gazebo_ros_diff_drive import GazeboRosDiffDrive
 from .plugins.gazebo_ros_laser import GazeboRosLaser
 from .plugins.model_joint_states import ModelJointStatePublisher
@@ -73,9 +76,10 @@ def _resolve_package_uris(xml: str) -> str:
 class GazeboRosApi:
     def __init__(self, node):
         self.node = node
-        self.model_states_publisher = rospy.Publisher("~model_states", ModelStates, queue_size=1)
+        self.model_states_publisher = loop_publisher("~model_states", ModelStates)
         self._services = [
             rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
+            rospy.Service("~spawn_sdf_model", SpawnModel, self._spawn_sdf_model),
             rospy.Service("~delete_model", DeleteModel, self._delete_model),
             rospy.Service("~get_model_state", GetModelState, self._get_model_state),
             rospy.Service("~set_model_state", SetModelState, self._set_model_state),
@@ -113,6 +117,26 @@ class GazeboRosApi:
                 _inject_namespace(model, namespace)
             pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
             self.spawn_robot(model, name, pose, namespace or "/")
+            return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
+        return self._guarded(SpawnModelResponse, spawn)
+
+    def _spawn_sdf_model(self, request):
+        """A world-like model (no plugins or joints are simulated for SDF models), placed like gazebo_ros does."""
+        def spawn():
+            name = request.model_name
+            if name in self.node.engine.model_names():
+                raise ModelError("SpawnModel: Failure - entity already exists: %s" % name)
+            pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+            world_xml = spawn_world_xml(_resolve_package_uris(request.model_xml), name, pose)
+            # The world loader reads files (relative URIs resolve against them); a private temp file holds it.
+            with tempfile.NamedTemporaryFile("w", prefix="mbot_spawn_", suffix=".world") as world_file:
+                world_file.write(world_xml)
+                world_file.flush()
+                description = parse_world(world_file.name, default_model_path())
+            self.node.engine.add_world(load_world(self.node.engine.client, description))
+            if name not in self.node.engine.model_names():
+                raise ModelError("model '%s' has no collision geometry; nothing to simulate" % name)
+            rospy.loginfo("spawned SDF model '%s' at %s", name, tuple(round(v, 3) for v in pose.position))
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
 

@@ -21,13 +21,13 @@ class CoreDrive:
     def __init__(self, urdf, casters_fixed=True):
         self.engine = Engine()
         world = load_world(self.engine.client, parse_world(EMPTY_WORLD))
-        self.engine.add_world_bodies(world.bodies)
+        self.engine.add_world(world)
         self.robot = self.engine.spawn_robot(parse_robot(urdf), "mbot", driven_joints=WHEELS if casters_fixed else
                                              WHEELS + ("back_caster_joint",))
         self.geometry = DiffDriveGeometry(0.24, 0.032, legacy_mode=True)
 
     def drive(self, linear, angular, seconds):
-        """Returns (pose at the end, pose one second before the end)."""
+        """Returns (pose at the end, pose one second before the end); ``seconds`` must exceed 1."""
         ramp, last, poses = WheelSpeedRamp(1.8), self.engine.sim_time, []
         for step in range(int(round(seconds / 0.001))):
             self.engine.step()
@@ -90,10 +90,10 @@ def test_spawn_pose_and_reset_world(core_drive, mbot_urdf):
     other = engine.spawn_robot(parse_robot(mbot_urdf), "second", pose_from_xyz_rpy((2.0, 1.0, 0.0), (0, 0, 1.0)))
     assert other.root_pose().position == pytest.approx((2.0, 1.0, 0.0), abs=1e-6)
     assert yaw(other.root_pose().orientation) == pytest.approx(1.0)
-    core_drive.drive(0.3, 0.0, 1.0)
+    core_drive.drive(0.3, 0.0, 1.5)
     engine.reset_world()
     assert core_drive.robot.root_pose().position == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
-    assert engine.sim_time == pytest.approx(1.0)
+    assert engine.sim_time == pytest.approx(1.5)
     engine.reset_simulation()
     assert engine.sim_time == 0.0
 

@@ -109,7 +109,8 @@ def test_shipped_world_loads_without_warnings(path, client, caplog, no_gazebo_mo
     assert len(loaded.shapes) == len(description.shapes)
 
 
-def test_every_world_is_shipped():
+def test_the_shipped_worlds_are_all_found():
+    """Guards the parametrized test above, which would pass vacuously if the folder moved."""
     assert [os.path.basename(path) for path in SHIPPED_WORLDS] == ["empty.world", "playground.world", "room.world"]
 
 
@@ -166,7 +167,7 @@ def test_a_6_m_lidar_at_the_start_sees_obstacles_all_around(playground, client):
 
 
 def test_playground_jersey_barrier_lies_across_the_x_axis_at_5_m(playground, client):
-    description, loaded = playground
+    description, _ = playground
     barrier = next(model for model in description.models if model.name == "jersey_barrier")
     assert barrier.static
     (_, y_min, z_min), (_, y_max, z_max) = barrier.shapes[0].bounds()
@@ -195,7 +196,7 @@ def test_playground_jersey_barrier_stops_a_robot_sized_disc_at_half_a_metre_per_
 
     drive_for(3000)  # 1.7 s to reach the barrier, then 1.3 s pushing against it
     assert front() == pytest.approx(5.0, abs=0.01)
-    assert client.getBasePositionAndOrientation(disc)[0][2] < height
+    assert client.getBasePositionAndOrientation(disc)[0][2] < height  # held back, not climbing the curb
 
 
 # --- Poses ----------------------------------------------------------------------------------------------------
@@ -392,8 +393,8 @@ def test_meshes_of_every_format_and_kind_of_uri(client, caplog):
 def test_binary_stl_reads_like_ascii_stl(tmp_path):
     ascii_mesh = load_mesh(os.path.join(TEST_WORLDS, "meshes", "block.stl"))
     corners = ascii_mesh.vertices[ascii_mesh.triangles].astype("<f4")
-    records = np.zeros(len(corners), dtype=[("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)),
-                                             ("attribute", "<u2")])
+    stl_triangle = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
+    records = np.zeros(len(corners), dtype=stl_triangle)
     records["vertices"] = corners
     path = tmp_path / "block.stl"
     path.write_bytes(b"solid but binary".ljust(80, b" ") + np.uint32(len(records)).tobytes() + records.tobytes())
@@ -406,7 +407,7 @@ def test_outline_is_the_top_view_footprint():
     description = read_test_world("nested_poses.world")
     ball = shape_named(description, "ball")
     radii = [math.hypot(x + 1.0, y - 0.5) for x, y in ball.outline()]
-    assert len(radii) == 32 and radii == pytest.approx([0.1] * 32)
+    assert len(radii) == 32 and radii == pytest.approx([0.1] * 32, abs=1e-6)
     tip = shape_named(description, "tip")  # 0.2 x 0.4 box turned 180 degrees at the origin
     assert sorted(tip.outline()) == pytest.approx([(-0.1, -0.2), (-0.1, 0.2), (0.1, -0.2), (0.1, 0.2)], abs=1e-6)
     assert read_test_world("include.world").shapes[0].outline() == ()  # the infinite ground plane
@@ -494,3 +495,22 @@ def test_what_is_not_simulated_warns_once_each_and_the_rest_loads(caplog, client
         at("door_opener") + "<plugin name='door_opener'> (libdoor_opener.so) is not simulated; ignored",
     ])
     assert [shape.name for shape in build(client, description).shapes] == ["box", "panel"]
+
+
+def test_a_second_model_with_the_same_name_warns_and_is_skipped(tmp_path, caplog):
+    path = write(tmp_path, "w.world", world_text(BOX_MODEL + "\n" + BOX_MODEL.replace("1 1 1", "2 2 2")))
+    (model,) = parse_world(path, model_path=[]).models
+    assert model.shapes[0].size == (1.0, 1.0, 1.0)
+    assert warnings_in(caplog) == [f"{path}:12: a model named 'box' already exists; this one is skipped"]
+
+
+def test_a_model_that_includes_itself_is_a_world_error(tmp_path):
+    model = tmp_path / "models" / "loop"
+    model.mkdir(parents=True)
+    write(model, "model.config", '<model><sdf version="1.6">model.sdf</sdf></model>')
+    write(model, "model.sdf", '<sdf version="1.6"><model name="loop"><include><uri>model://loop</uri></include>'
+                              '</model></sdf>')
+    path = write(tmp_path, "w.world", world_text("<include><uri>model://loop</uri></include>"))
+    with pytest.raises(WorldError) as error:
+        parse_world(path, model_path=[str(tmp_path / "models")])
+    assert str(error.value) == f"{model}/model.sdf:1: {model}/model.sdf includes itself"

@@ -10,7 +10,6 @@ import tempfile
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
-import numpy
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
@@ -18,7 +17,7 @@ from .errors import ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
 from .log import get_logger, warn_once
 from .robot_model import RobotModel
-from .world import PhysicsConfig
+from .world import LoadedWorld, PhysicsConfig
 
 _logger = get_logger(__name__)
 
@@ -56,6 +55,20 @@ def root_from_com(client: BulletClient, body: int) -> Pose:
     return inverse(Pose(tuple(inertial[3]), tuple(inertial[4])))
 
 
+def frame_pose(client: BulletClient, body: int, frame_from_com: Pose) -> Pose:
+    position, orientation = client.getBasePositionAndOrientation(body)
+    return compose(Pose(tuple(position), tuple(orientation)), frame_from_com)
+
+
+def frame_velocity(client: BulletClient, body: int, frame_position) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
+    """World-frame (linear velocity of a point fixed to the base, angular velocity): v_com + ω × r."""
+    com, _ = client.getBasePositionAndOrientation(body)
+    (vx, vy, vz), (wx, wy, wz) = client.getBaseVelocity(body)
+    rx, ry, rz = (frame_position[i] - com[i] for i in range(3))
+    # Written out: numpy.cross costs more than a physics step on 3-vectors.
+    return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx), (wx, wy, wz)
+
+
 class SpawnedRobot:
     """A URDF robot in the engine, addressed by URDF link and joint names."""
 
@@ -77,16 +90,11 @@ class SpawnedRobot:
         self.movable_joints = [joint.name for joint in model.movable_joints() if joint.name in self.joint_index]
 
     def root_pose(self) -> Pose:
-        position, orientation = self.client.getBasePositionAndOrientation(self.body)
-        return compose(Pose(tuple(position), tuple(orientation)), self.root_from_com)
+        return frame_pose(self.client, self.body, self.root_from_com)
 
-    def root_velocity(self) -> Tuple[numpy.ndarray, numpy.ndarray]:
+    def root_velocity(self):
         """World-frame (linear velocity of the root link frame's origin, angular velocity)."""
-        com_position, _ = self.client.getBasePositionAndOrientation(self.body)
-        linear, angular = self.client.getBaseVelocity(self.body)
-        linear, angular = numpy.array(linear), numpy.array(angular)
-        offset = numpy.array(self.root_pose().position) - numpy.array(com_position)
-        return linear + numpy.cross(angular, offset), angular
+        return frame_velocity(self.client, self.body, self.root_pose().position)
 
     def link_world_pose(self, link_name: str) -> Pose:
         """World pose of any URDF link's frame, lumped ones included."""
@@ -126,14 +134,17 @@ class Engine:
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self._initial: Dict[int, _InitialState] = {}
+        # Per body, the model frame seen from the centre of mass where PyBullet places a base.
+        self._root_from_com: Dict[int, Pose] = {}
 
     @property
     def sim_time(self) -> float:
         return self.steps * self.physics.max_step_size
 
     def step(self, count: int = 1):
+        step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
         for _ in range(count):
-            self.client.stepSimulation()
+            step()
         self.steps += count
 
     def set_gravity(self, gravity: Sequence[float]):
@@ -141,10 +152,11 @@ class Engine:
                                      self.physics.real_time_update_rate, tuple(gravity))
         self.client.setGravity(*gravity)
 
-    def add_world_bodies(self, bodies: Dict[str, int]):
-        """Register bodies a world loader built, so reset and model queries know them."""
-        for name, body in bodies.items():
+    def add_world(self, world: LoadedWorld):
+        """Register the bodies a world loader built, so reset and model queries know them."""
+        for name, body in world.bodies.items():
             self.world_bodies[name] = body
+            self._root_from_com[body] = inverse(world.inertial_frames[name])
             self._remember_initial_state(body)
 
     def model_names(self) -> List[str]:
@@ -165,6 +177,7 @@ class Engine:
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
         self.robots[name] = robot
+        self._root_from_com[body] = robot.root_from_com
         self._remember_initial_state(body)
         return robot
 
@@ -176,6 +189,7 @@ class Engine:
         else:
             raise ModelError("model '%s' does not exist" % name)
         self._initial.pop(body, None)
+        self._root_from_com.pop(body, None)
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -186,21 +200,18 @@ class Engine:
         raise ModelError("model '%s' does not exist" % name)
 
     def model_pose(self, name: str) -> Pose:
-        if name in self.robots:
-            return self.robots[name].root_pose()
-        position, orientation = self.client.getBasePositionAndOrientation(self.body_of(name))
-        return Pose(tuple(position), tuple(orientation))
+        """World pose of a model's frame (a robot's root link, a world model's <model> frame)."""
+        body = self.body_of(name)
+        return frame_pose(self.client, body, self._root_from_com[body])
 
-    def model_velocity(self, name: str) -> Tuple[numpy.ndarray, numpy.ndarray]:
-        if name in self.robots:
-            return self.robots[name].root_velocity()
-        linear, angular = self.client.getBaseVelocity(self.body_of(name))
-        return numpy.array(linear), numpy.array(angular)
+    def model_velocity(self, name: str):
+        """World-frame (linear velocity of the model frame's origin, angular velocity)."""
+        return frame_velocity(self.client, self.body_of(name), self.model_pose(name).position)
 
     def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
         """Move a model's frame to ``pose`` and give every link the same world velocity (as Gazebo does)."""
         body = self.body_of(name)
-        com = compose(pose, inverse(self.robots[name].root_from_com)) if name in self.robots else pose
+        com = compose(pose, inverse(self._root_from_com[body]))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)
 

@@ -116,7 +116,7 @@ def _read_collada(path: str) -> np.ndarray:
     try:
         import collada
     except ImportError:
-        raise ModelError(f"{path}: reading COLLADA meshes needs pycollada: pip install {PYCOLLADA_REQUIREMENT}") from None
+        raise ModelError(f"{path}: reading COLLADA needs pycollada: pip install {PYCOLLADA_REQUIREMENT}") from None
     corners = []
     try:
         with warnings.catch_warnings():

@@ -7,8 +7,8 @@ physics-relevant elements that are not simulated (joints, plugins, unknown geome
 file and line.
 
 Each model becomes one PyBullet multibody: a base that carries the model's mass and every collision as a
-massless child on a fixed joint. A static model gets mass 0, which PyBullet treats as immovable. Links
-are not jointed, so the links of one model move as one rigid body.
+massless child on a fixed joint. A static model gets mass 0, which PyBullet treats as immovable. SDF
+joints are not simulated, so the links of one model move as one rigid body.
 """
 import os
 import xml.etree.ElementTree as ET
@@ -196,8 +196,8 @@ def _workspace_models() -> Optional[str]:
     # The real path leads back to the source tree from a source checkout and from catkin's devel space
     # (its generated package __init__ extends __path__ to the sources). An install space has no repo root,
     # so ROS_PACKAGE_PATH is tried for mbot_gazebo, whose worlds/ links to the same folder.
-    repo_root = Path(os.path.realpath(__file__)).parents[5]
-    candidates = [repo_root / "worlds" / "models"]
+    module = Path(os.path.realpath(__file__))  # <repo>/src/mbot_sim_bridge/src/mbot_sim_bridge/core/world.py
+    candidates = [module.parents[5] / "worlds" / "models"] if len(module.parents) > 5 else []
     candidates += [Path(entry) / "mbot_gazebo" / "worlds" / "models"
                    for entry in os.environ.get("ROS_PACKAGE_PATH", "").split(":") if entry]
     return next((str(candidate) for candidate in candidates if candidate.is_dir()), None)
@@ -250,6 +250,8 @@ def _create_body(client, model: ModelDescription, collision_shapes) -> Tuple[int
     world_to_model = inverse(model.pose)
     child_frames = [compose(world_to_model, shape.pose) for shape, _ in collision_shapes]
     mass, inertial_frame, moments = (0.0, IDENTITY, None) if model.static else _mass_properties(model)
+    if not model.static and mass == 0.0:
+        warn_once(_log, f"model '{model.name}' is not static but has no mass; PyBullet keeps it fixed")
     count = len(collision_shapes)
     body = client.createMultiBody(
         baseMass=mass, baseCollisionShapeIndex=-1, basePosition=model.pose.position,
@@ -270,7 +272,7 @@ def _create_body(client, model: ModelDescription, collision_shapes) -> Tuple[int
     return body, inertial_frame
 
 
-def _mass_properties(model: ModelDescription) -> Tuple[float, Pose, Tuple[float, float, float]]:
+def _mass_properties(model: ModelDescription) -> Tuple[float, Pose, Optional[Tuple[float, float, float]]]:
     """Total mass, principal centre-of-mass frame (in the model frame) and principal moments of the welded links."""
     world_to_model = inverse(model.pose)
     frames = [compose(world_to_model, compose(link.pose, link.inertial_pose)) for link in model.links]
@@ -314,7 +316,8 @@ def _quaternion_from_matrix(matrix: np.ndarray) -> Tuple[float, float, float, fl
 
 def _convex_hull_2d(points: np.ndarray) -> Tuple[Tuple[float, float], ...]:
     """Andrew's monotone chain; counter-clockwise, no repeated first point."""
-    unique = sorted({(float(x), float(y)) for x, y in np.round(points, 9)})
+    # Micrometres: below that, PyBullet's single-precision transforms make straight edges look bent.
+    unique = sorted({(float(x) + 0.0, float(y) + 0.0) for x, y in np.round(points, 6)})
     if len(unique) < 3:
         return tuple(unique)
 
@@ -371,6 +374,12 @@ class _ModelEntry(NamedTuple):
     pose: Optional[ET.Element]
     pose_document: _Document
     static: Optional[bool]
+    where: str  # the <model> or <include> in the including file, for messages
+
+
+def _inline_model(element: ET.Element, document: _Document) -> _ModelEntry:
+    return _ModelEntry(element, document, element.get("name", ""), element.find("pose"), document, None,
+                       document.where(element))
 
 
 class _Frames:
@@ -430,7 +439,7 @@ class _WorldParser:
         entries = []
         for child in world:
             if child.tag == "model":
-                entries.append(_ModelEntry(child, document, child.get("name", ""), child.find("pose"), document, None))
+                entries.append(_inline_model(child, document))
             elif child.tag == "include":
                 entries.extend(self._include(child, document))
             elif child.tag == "frame":
@@ -442,8 +451,7 @@ class _WorldParser:
         unique = {}
         for entry in entries:
             if entry.name in unique:
-                warn_once(_log, f"{entry.document.where(entry.element)}: a model named '{entry.name}' "
-                                f"already exists; this one is skipped")
+                warn_once(_log, f"{entry.where}: a model named '{entry.name}' already exists; this one is skipped")
                 continue
             unique[entry.name] = entry
             scope.add(entry.name, entry.pose, entry.pose_document)
@@ -501,8 +509,8 @@ class _WorldParser:
         if not os.path.isfile(config_path):
             config_path = os.path.join(directory, "manifest.xml")
         config = self._read(config_path)
-        choices = [(_version(entry.get("version", "")), (entry.text or "").strip()) for entry in config.root.iter("sdf")]
-        choices = [(version, name) for version, name in choices if name]
+        choices = [(_version(entry.get("version", "")), (entry.text or "").strip())
+                   for entry in config.root.iter("sdf") if (entry.text or "").strip()]
         if not choices:
             raise WorldError(f"{config_path}: no <sdf> entry names a model file")
         supported = [choice for choice in choices if choice[0] <= SDF_VERSION]
@@ -558,7 +566,7 @@ class _WorldParser:
         return [_ModelEntry(model, model_document, _text(include, "name") or model.get("name", ""),
                             pose if pose is not None else model.find("pose"),
                             document if pose is not None else model_document,
-                            None if static is None else _bool(static, document))]
+                            None if static is None else _bool(static, document), document.where(include))]
 
     def _model(self, entry: _ModelEntry, parent: _Frames) -> ModelDescription:
         static = entry.static
@@ -566,12 +574,13 @@ class _WorldParser:
             static = _bool(entry.element.find("static"), entry.document, default=False)
         scope = _Frames(f"model '{entry.name}'", parent.frame(entry.name, entry.document, entry.element),
                         ("", "__model__"))
-        links = self._links(entry, scope, static, entry.name, prefix="", files=(entry.document.path,))
+        links = self._links(entry, scope, static, entry.name, prefix="", expanding=(entry.element,))
         return ModelDescription(entry.name, static, scope.origin, tuple(links))
 
     def _links(self, entry: _ModelEntry, scope: _Frames, static: bool, model: str, prefix: str,
-               files: Tuple[str, ...]) -> List[LinkDescription]:
-        """Links of a model and of the models nested in it, flattened; ``files`` are the includes on the way."""
+               expanding: Tuple[ET.Element, ...]) -> List[LinkDescription]:
+        """Links of a model and of the models nested in it, flattened; ``expanding`` are the <model>s on the way
+        (an included file is read once, so including a model inside itself meets the same element again)."""
         element, document = entry.element, entry.document
         nested = []
         for child in element:
@@ -579,7 +588,7 @@ class _WorldParser:
                 default = child.get("attached_to", "") if child.tag == "frame" else ""
                 scope.add(child.get("name", ""), child.find("pose"), document, default)
             elif child.tag == "model":
-                nested.append(_ModelEntry(child, document, child.get("name", ""), child.find("pose"), document, None))
+                nested.append(_inline_model(child, document))
             elif child.tag == "include":
                 nested.extend(self._include(child, document))
             elif child.tag in _MODEL_UNSUPPORTED:
@@ -590,12 +599,12 @@ class _WorldParser:
             scope.add(inner.name, inner.pose, inner.pose_document)
         links = [self._link(link, document, scope, static, model, prefix) for link in element.findall("link")]
         for inner in nested:
-            if inner.document is not document and inner.document.path in files:
-                raise WorldError(f"{document.path}: includes {inner.document.path}, which includes it back")
+            if inner.element in expanding:
+                raise WorldError(f"{inner.where}: {inner.document.path} includes itself")
             inner_scope = _Frames(f"model '{inner.name}'", scope.frame(inner.name, document, inner.element),
                                   ("", "__model__"))
             links += self._links(inner, inner_scope, static, model, f"{prefix}{inner.name}::",
-                                 files + (inner.document.path,))
+                                 expanding + (inner.element,))
         return links
 
     def _link(self, link: ET.Element, document: _Document, scope: _Frames, static: bool, model: str,

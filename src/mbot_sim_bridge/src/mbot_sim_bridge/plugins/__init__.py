@@ -4,20 +4,44 @@ A plugin reads its tags through the core's Param tables, takes core objects (eng
 only publishes and subscribes. The node calls ``update`` when the plugin's timer is due, in the thread
 that owns the engine.
 """
+import warnings
 from dataclasses import dataclass
 from typing import Callable, Optional
 
 import rospy
+from tf2_msgs.msg import TFMessage
 
 from ..core.clock import UpdateTimer
 from ..core.engine import Engine, SpawnedRobot
+
+
+def loop_publisher(name: str, message_type) -> rospy.Publisher:
+    """A publisher written to synchronously by the loop thread.
+
+    rospy's queued publishers hand each message to a writer thread and then call time.sleep(0) to yield the
+    GIL, a hand-off that costs more than a physics step. The loop is the only thread publishing these topics,
+    so it writes them itself (queue_size=None); rospy warns about that choice, which here is deliberate.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SyntaxWarning)
+        return rospy.Publisher(name, message_type, queue_size=None)
+
+
+class TransformBroadcaster:
+    """tf2_ros.TransformBroadcaster's job (a TFMessage on /tf) through a loop publisher."""
+
+    def __init__(self):
+        self.publisher = loop_publisher("/tf", TFMessage)
+
+    def send_transform(self, transform):
+        self.publisher.publish(TFMessage([transform]))
 
 
 @dataclass
 class PluginContext:
     engine: Engine
     robot: SpawnedRobot
-    tf_broadcaster: object  # tf2_ros.TransformBroadcaster shared by all plugins
+    tf_broadcaster: TransformBroadcaster  # shared by all plugins
     stamp: Callable[[], rospy.Time]  # the current sim time as a ROS stamp
 
 

@@ -14,7 +14,7 @@ from ..core.diff_drive import (DIFF_DRIVE_IGNORED_TAGS, DIFF_DRIVE_PARAMS, ODOM_
 from ..core.errors import ConfigError
 from ..core.geometry import yaw
 from ..core.params import PluginParams
-from . import BridgePlugin, PluginContext, resolve_frame, resolve_in_namespace
+from . import BridgePlugin, PluginContext, loop_publisher, resolve_frame, resolve_in_namespace
 
 _LOG_LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WARNING, "error": logging.ERROR,
                "fatal": logging.CRITICAL}
@@ -61,10 +61,9 @@ class GazeboRosDiffDrive(BridgePlugin):
         self._lock = threading.Lock()
         self._command = (0.0, 0.0)
         # publishTf=false means no odometry topic at all, not just no TF (gazebo_ros reads it that way).
-        self.odom_publisher = (rospy.Publisher(resolve_in_namespace(namespace, params["odometryTopic"]),
-                                               Odometry, queue_size=1) if params["publishTf"] else None)
-        self.joint_state_publisher = (rospy.Publisher(resolve_in_namespace(namespace, "joint_states"), JointState,
-                                                      queue_size=1000)
+        self.odom_publisher = (loop_publisher(resolve_in_namespace(namespace, params["odometryTopic"]), Odometry)
+                               if params["publishTf"] else None)
+        self.joint_state_publisher = (loop_publisher(resolve_in_namespace(namespace, "joint_states"), JointState)
                                       if params["publishWheelJointState"] else None)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
         self.subscriber = rospy.Subscriber(self.command_topic, Twist, self._on_command, queue_size=1)
@@ -142,7 +141,7 @@ class GazeboRosDiffDrive(BridgePlugin):
             transform.transform.translation.y = pose.position.y
             transform.transform.translation.z = pose.position.z
             transform.transform.rotation = pose.orientation
-            self.context.tf_broadcaster.sendTransform(transform)
+            self.context.tf_broadcaster.send_transform(transform)
 
     def _publish_wheel_joint_states(self, stamp):
         # gazebo_ros lists the right wheel first and leaves velocity and effort empty.

@@ -5,7 +5,7 @@ from sensor_msgs.msg import LaserScan
 from ..core.clock import UpdateTimer
 from ..core.geometry import compose
 from ..core.lidar import LaserScanner, parse_ray_sensor
-from . import BridgePlugin, PluginContext, resolve_frame, resolve_in_namespace
+from . import BridgePlugin, PluginContext, loop_publisher, resolve_frame, resolve_in_namespace
 
 
 class GazeboRosLaser(BridgePlugin):
@@ -18,8 +18,7 @@ class GazeboRosLaser(BridgePlugin):
         namespace = self.config.robot_namespace
         if namespace == "":
             namespace = context.robot.name
-        self.publisher = rospy.Publisher(resolve_in_namespace(namespace, self.config.topic_name), LaserScan,
-                                         queue_size=1)
+        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.config.topic_name), LaserScan)
         # Everything but this robot's own bit: the scan never sees the robot that carries the sensor.
         self.collision_filter_mask = -1 & ~context.robot.collision_group
         self.message = LaserScan()

@@ -4,20 +4,19 @@ Gazebo leaves these joints to joint_state_publisher, which can only publish zero
 and the wheels fighting the diff drive). The bridge publishes their simulated state instead, so that
 robot_state_publisher builds the whole tree from one publisher per joint.
 """
-import rospy
 from sensor_msgs.msg import JointState
 
 from ..core.clock import UpdateTimer
-from . import BridgePlugin, PluginContext, resolve_in_namespace
+from . import BridgePlugin, PluginContext, loop_publisher, resolve_in_namespace
 
 
 class ModelJointStatePublisher(BridgePlugin):
     def __init__(self, context: PluginContext, joint_names, rate: float):
         self.context = context
         self.joint_names = list(joint_names)
-        self.timer = UpdateTimer(rate, start=context.engine.sim_time)
-        self.publisher = rospy.Publisher(resolve_in_namespace(context.robot.namespace, "joint_states"),
-                                         JointState, queue_size=10)
+        # Timed like the diff drive (one step after each period), so both publish in the same loop pass.
+        self.timer = UpdateTimer(rate, strict=True, start=context.engine.sim_time)
+        self.publisher = loop_publisher(resolve_in_namespace(context.robot.namespace, "joint_states"), JointState)
 
     def update(self, now: float):
         message = JointState()

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Speed figures of the simulator, printed one per line (``./mbot bench``).
+
+(a) raw PyBullet: the course's mbot driven by the core's diff-drive loop in the empty world, no ROS;
+(b) the bridge: the course's empty-world launch file at real-time factor 0 with every topic subscribed;
+the real-time factor of each and their ratio, the wall time from roslaunch to the first /odom, and the
+cost of one lidar scan (bench_lidar.py).
+"""
+import argparse
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
+STEP = 0.001
+WHEELS = ("left_wheel_joint", "right_wheel_joint")
+
+
+def raw_pybullet_rtf(sim_seconds: float) -> float:
+    import xacro
+    from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
+    from mbot_sim_bridge.core.engine import Engine
+    from mbot_sim_bridge.core.robot_model import parse_robot
+    from mbot_sim_bridge.core.world import load_world, parse_world
+
+    urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
+                                           "mbot_gazebo.xacro")).toxml()
+    engine = Engine()
+    engine.add_world(load_world(engine.client, parse_world(os.path.join(WORKSPACE, "worlds", "empty.world"))))
+    robot = engine.spawn_robot(parse_robot(urdf), "mbot", driven_joints=WHEELS)
+    geometry, ramp = DiffDriveGeometry(0.24, 0.032, True), WheelSpeedRamp(1.8)
+    started, last = time.perf_counter(), 0.0
+    # The bridge's work minus ROS: step, and at 100 Hz read the wheels and set their motors.
+    for _ in range(int(sim_seconds / STEP)):
+        engine.step()
+        if engine.sim_time - last > 0.01 + 1e-9:
+            measured = [rate * 0.032 for _, rate, _ in robot.joint_state(WHEELS)]
+            speeds = ramp.step(geometry.wheel_rim_speeds(0.3, 0.5), measured, engine.sim_time - last)
+            last += 0.01
+            for joint, speed in zip(WHEELS, speeds):
+                robot.set_joint_velocity(joint, speed / 0.032, 30.0)
+    elapsed = time.perf_counter() - started
+    engine.close()
+    return sim_seconds / elapsed
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def bridge_figures(wall_seconds: float):
+    """(real-time factor, seconds from roslaunch to the first /odom) with every topic subscribed."""
+    port = _free_port()
+    os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
+    master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, start_new_session=True)
+    launch = None
+    try:
+        import rosgraph
+        import rospy
+        from nav_msgs.msg import Odometry
+        from rosgraph_msgs.msg import Clock
+        while not rosgraph.is_master_online():
+            time.sleep(0.05)
+        rospy.init_node("bench_bridge", disable_signals=True)
+        started = time.monotonic()
+        launch = subprocess.Popen(["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=false",
+                                   "real_time_factor:=0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                  start_new_session=True)
+        rospy.wait_for_message("/odom", Odometry, timeout=120)
+        first_odom = time.monotonic() - started
+        clock = []
+        subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
+                                                                                m.clock.to_sec())))]
+        # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
+        subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
+                        for topic, _ in rospy.get_published_topics() if topic != "/clock"]
+        time.sleep(1.0)  # let every subscription connect before the measured window
+        window_start = len(clock)
+        time.sleep(wall_seconds)
+        (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
+        for subscriber in subscribers:
+            subscriber.unregister()
+        return (sim1 - sim0) / (wall1 - wall0), first_odom, len(subscribers)
+    finally:
+        for process in (launch, master):
+            if process is not None and process.poll() is None:
+                os.killpg(process.pid, signal.SIGINT)
+                process.wait(timeout=30)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sim-seconds", type=float, default=20.0, help="sim time of the raw PyBullet run")
+    parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time the bridge is measured")
+    args = parser.parse_args()
+
+    raw = raw_pybullet_rtf(args.sim_seconds)
+    print("raw PyBullet real-time factor: %.2f" % raw, flush=True)
+    bridge, first_odom, topics = bridge_figures(args.wall_seconds)
+    print("bridge real-time factor (%d topics subscribed): %.2f" % (topics, bridge))
+    print("bridge / raw: %.2f" % (bridge / raw))
+    print("roslaunch to first /odom: %.2f s" % first_odom, flush=True)
+    sys.exit(subprocess.call([sys.executable, os.path.join(HERE, "bench_lidar.py")]))
+
+
+if __name__ == "__main__":
+    main()

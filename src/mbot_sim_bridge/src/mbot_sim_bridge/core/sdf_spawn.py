@@ -1,0 +1,61 @@
+"""spawn_sdf_model's input -> a one-model SDF world the world loader reads.
+
+gazebo_ros accepts ``<sdf><model>`` (spawn_model -file/-param) and ``<sdf><world><include>`` (what
+spawn_model -database sends). The model is renamed to the requested name and placed at the requested pose
+composed with its own, as spawn_sdf_model does.
+"""
+from xml.etree import ElementTree
+
+from .errors import ModelError
+from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, rpy
+
+
+def _pose_text(pose: Pose) -> str:
+    return " ".join("%.9g" % value for value in tuple(pose.position) + tuple(rpy(pose.orientation)))
+
+
+def _element_pose(element: ElementTree.Element, where: str) -> Pose:
+    pose = element.find("pose")
+    if pose is None or not (pose.text or "").strip():
+        return IDENTITY
+    try:
+        values = [float(value) for value in pose.text.split()]
+    except ValueError:
+        values = []
+    if len(values) != 6:
+        raise ModelError("%s: <pose> must hold 6 numbers, got '%s'" % (where, pose.text.strip()))
+    return pose_from_xyz_rpy(values[:3], values[3:])
+
+
+def _set_pose(element: ElementTree.Element, pose: Pose):
+    existing = element.find("pose")
+    if existing is None:
+        existing = ElementTree.SubElement(element, "pose")
+    existing.text = _pose_text(pose)
+
+
+def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
+    where = "model '%s'" % name
+    try:
+        root = ElementTree.fromstring(model_xml)
+    except ElementTree.ParseError as error:
+        raise ModelError("%s is not valid XML: %s" % (where, error)) from None
+    if root.tag != "sdf":
+        raise ModelError("%s is not SDF: its root element is <%s>, not <sdf>" % (where, root.tag))
+    world = root.find("world")
+    entries = (world.findall("model") + world.findall("include")) if world is not None else root.findall("model")
+    if len(entries) != 1:
+        raise ModelError("%s: expected exactly one <model> (or one <include> in a <world>), found %d"
+                         % (where, len(entries)))
+    entry = entries[0]
+    if entry.tag == "model":
+        entry.set("name", name)
+    else:
+        name_element = entry.find("name")
+        if name_element is None:
+            name_element = ElementTree.SubElement(entry, "name")
+        name_element.text = name
+    _set_pose(entry, compose(pose, _element_pose(entry, where)))
+    spawned = ElementTree.Element("sdf", version=root.get("version", "1.6"))
+    ElementTree.SubElement(spawned, "world", name="spawn").append(entry)
+    return ElementTree.tostring(spawned, encoding="unicode")
