@@ -23,6 +23,17 @@ def wait_until(condition, timeout, interval=0.02):
         time.sleep(interval)
 
 
+def stop(proc):
+    """End a process started in a session of its own: TERM, then KILL for its whole group."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=10)
+
+
 def teleop_command(*ros_args):
     """The teleop under this Python, with ROS command-line arguments (remaps, _params)."""
     return [sys.executable, TELEOP_SCRIPT, *ros_args]
@@ -93,14 +104,8 @@ class PtyProcess:
         return termios.tcgetattr(self._slave)
 
     def close(self):
-        """Stop the process if it still runs (TERM, then KILL) and release the pty."""
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait(timeout=10)
+        """Stop the process if it still runs and release the pty."""
+        stop(self.proc)
         self._closing.set()
         self._reader.join(timeout=5)
         os.close(self._master)
@@ -142,11 +147,6 @@ class TwistRecorder:
             return len(self.messages)
 
     def close(self):
-        self._echo.terminate()
-        try:
-            self._echo.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            self._echo.kill()
-            self._echo.wait(timeout=10)
+        stop(self._echo)
         self._reader.join(timeout=5)
         self._echo.stdout.close()

@@ -35,7 +35,7 @@ class TestTeleopDrive(unittest.TestCase):
         cls._odom = None
         cls._lock = threading.Lock()
         cls._odom_sub = rospy.Subscriber('/odom', Odometry, cls._store_odom)
-        if not wait_until(lambda: cls._latest(), SIM_TIMEOUT):
+        if not wait_until(cls._latest, SIM_TIMEOUT):
             raise AssertionError(f'no /odom within {SIM_TIMEOUT} s')
         cls.commands = TwistRecorder('/cmd_vel', os.environ)
         cls.teleop = PtyProcess(teleop_command(), source_env())

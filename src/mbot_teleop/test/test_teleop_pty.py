@@ -20,7 +20,7 @@ import pytest
 import rosgraph
 
 from teleop_harness import (
-    PACKAGE_DIR, PtyProcess, TwistRecorder, source_env, teleop_command, wait_until)
+    PACKAGE_DIR, PtyProcess, TwistRecorder, source_env, stop, teleop_command, wait_until)
 
 NOT_A_TERMINAL = ('mbot_teleop: stdin is not a terminal; run it from a terminal: '
                   'rosrun mbot_teleop mbot_teleop.py')
@@ -49,14 +49,12 @@ def _master_answers(uri):
     return True
 
 
-def _stop(proc):
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(timeout=10)
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
 
 
 @pytest.fixture(scope='module')
@@ -67,12 +65,13 @@ def ros_env(tmp_path_factory):
     env.update(ROS_MASTER_URI=f'http://localhost:{port}/', ROS_HOSTNAME='localhost',
                ROS_HOME=str(tmp_path_factory.mktemp('ros_home')))
     master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                              start_new_session=True)
     try:
         assert wait_until(lambda: _master_answers(env['ROS_MASTER_URI']), START_TIMEOUT)
         yield env
     finally:
-        _stop(master)
+        stop(master)
 
 
 @pytest.fixture
@@ -275,22 +274,11 @@ def test_launch_file_gives_the_node_the_terminal_and_course_speeds(ros_env):
         # The teleop was the launch's only node, so roslaunch ends with it.
         launch.send('\x03')
         assert launch.proc.wait(timeout=STEP_TIMEOUT) == 0
-        assert 'process has finished cleanly' in launch.output
+        assert launch.wait_for_output('process has finished cleanly', STEP_TIMEOUT)
         assert launch.mode() == launch.initial_mode
     finally:
-        if launch.proc.poll() is None:
-            launch.proc.send_signal(signal.SIGINT)
-            launch.proc.wait(timeout=30)
         launch.close()
         recorder.close()
         # roslaunch gives each node a session of its own, so make sure the node went with it.
         if teleop_pid is not None and wait_until(lambda: not _alive(teleop_pid), 10) is None:
             os.kill(teleop_pid, signal.SIGKILL)
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    return True

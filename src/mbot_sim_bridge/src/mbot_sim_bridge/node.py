@@ -20,6 +20,7 @@ from rosgraph_msgs.msg import Clock
 from .core.clock import UpdateTimer
 from .core.engine import Engine
 from .core.errors import BridgeError, WorldError
+from .core.viewer import Viewer
 from .core.world import PhysicsConfig, default_model_path, load_world, parse_world
 from .plugins import BridgePlugin, TransformBroadcaster, loop_publisher
 from .services import GazeboRosApi
@@ -55,6 +56,7 @@ class SimBridgeNode:
         if requested_gui and not self.gui:
             rospy.loginfo("gui:=true but no DISPLAY is set: running without a window")
         self.engine = Engine(self.physics, pybullet.GUI if self.gui else pybullet.DIRECT)
+        self.viewer = Viewer(self.engine) if self.gui else None
         self.world = load_world(self.engine.client, world)
         self.engine.add_world(self.world)
         self.real_time_factor = (float(real_time_factor) if real_time_factor
@@ -119,6 +121,8 @@ class SimBridgeNode:
             for plugin in every_step:
                 plugin.on_step(self.physics.max_step_size)
             self._run_due_updates()
+            if self.viewer is not None:
+                self.viewer.follow()
             self._pace()
 
     def _steps_to_next_event(self) -> int:

@@ -168,6 +168,8 @@ class GazeboRosApi:
             engine.remove(name)
             raise
         self.node.plugins[name] = plugins
+        if self.node.viewer is not None:
+            self.node.viewer.show_robot(robot)
         rospy.loginfo("spawned '%s' (%d links, %d movable joints, %d plugins) at %s", name, len(robot.link_index),
                       len(robot.movable_joints), len(plugins), tuple(round(v, 3) for v in pose.position))
         return robot
@@ -191,6 +193,8 @@ class GazeboRosApi:
         def delete():
             for plugin in self.node.plugins.pop(request.model_name, []):
                 plugin.close()
+            if self.node.viewer is not None and request.model_name in self.node.engine.robots:
+                self.node.viewer.forget_robot(self.node.engine.robots[request.model_name])
             self.node.engine.remove(request.model_name)
             return DeleteModelResponse(success=True, status_message="DeleteModel: successfully deleted model")
         return self._guarded(DeleteModelResponse, delete)

@@ -23,6 +23,7 @@ import pybullet
 from .errors import ModelError, WorldError
 from .geometry import IDENTITY, Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
 from .log import get_logger, warn_once
+from .materials import sdf_material_rgba
 from .mesh import TriangleMesh, load_mesh
 
 _log = get_logger(__name__)
@@ -88,6 +89,7 @@ class Shape:
     mesh: Optional[TriangleMesh] = field(default=None, compare=False, repr=False)  # scaled, collision frame
     mu: float = 1.0
     mu2: float = 1.0
+    rgba: Optional[Tuple[float, float, float, float]] = None  # the link's first visual material, for the window
 
     def world_points(self, segments: int = 32) -> np.ndarray:
         """(N, 3) world points whose convex hull encloses the shape; round parts are ``segments``-gons.
@@ -221,6 +223,9 @@ def load_world(client, description: WorldDescription) -> LoadedWorld:
             _log.debug("model '%s' has no collision shape; no body created", model.name)
             continue
         bodies[model.name], inertial_frames[model.name] = _create_body(client, model, collision_shapes)
+        for index, (shape, _) in enumerate(collision_shapes):
+            if shape.rgba is not None:  # only the simulator window shows it
+                client.changeVisualShape(bodies[model.name], index, rgbaColor=shape.rgba)
         shapes.extend(shape for shape, _ in collision_shapes)
     return LoadedWorld(description.physics, bodies, tuple(shapes), inertial_frames)
 
@@ -619,7 +624,9 @@ class _WorldParser:
                 self._warn_unknown(document, child, "link")
         pose = scope.frame(name, document, link)
         mass, inertia, inertial_pose = self._inertial(link.find("inertial"), document, static)
-        collisions = (self._collision(collision, document, scope, name, static, model, prefix + name)
+        visual_materials = (sdf_material_rgba(visual.find("material")) for visual in link.findall("visual"))
+        rgba = next((colour for colour in visual_materials if colour is not None), None)
+        collisions = (self._collision(collision, document, scope, name, static, model, prefix + name, rgba)
                       for collision in link.findall("collision"))
         return LinkDescription(prefix + name, pose, mass, inertia, inertial_pose,
                                tuple(shape for shape in collisions if shape is not None))
@@ -640,7 +647,7 @@ class _WorldParser:
         return mass, inertia, IDENTITY if pose is None else _pose(pose, document)
 
     def _collision(self, collision: ET.Element, document: _Document, scope: _Frames, link: str, static: bool,
-                   model: str, scoped_link: str) -> Optional[Shape]:
+                   model: str, scoped_link: str, rgba) -> Optional[Shape]:
         name = collision.get("name", "")
         label = f"collision '{name}' of model '{model}'"
         geometry = collision.find("geometry")
@@ -654,7 +661,7 @@ class _WorldParser:
             return None
         pose = scope.resolve(collision.find("pose"), document, default=link)
         friction = collision.find("surface/friction/ode")
-        common = dict(model=model, link=scoped_link, name=name, kind=kind, pose=pose,
+        common = dict(model=model, link=scoped_link, name=name, kind=kind, pose=pose, rgba=rgba,
                       mu=_number(friction, "mu", document, 1.0) if friction is not None else 1.0,
                       mu2=_number(friction, "mu2", document, 1.0) if friction is not None else 1.0)
         if kind == "box":

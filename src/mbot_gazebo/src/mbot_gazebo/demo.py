@@ -1,0 +1,238 @@
+"""``./mbot demo``: the mbot with its lidar tours a world headless, then a picture shows what it saw.
+
+Starts a private ROS master and the course's launch file at the fastest real-time factor the machine
+sustains, drives a scripted tour through /cmd_vel (closed loop on /odom, so distances and turns come out
+the same at any speed), records /odom and /scan (through TF into odom), and writes out/demo.png.
+"""
+import argparse
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+WORLDS = {"play_ground": "playground.world", "playground": "playground.world", "room": "room.world",
+          "empty": "empty.world"}
+# The tour, in the robot's own terms: (metres forward, or a turn in place in degrees counter-clockwise).
+# It stays inside the play ground's free rectangle x -1.5..3.5, y -1.5..1.5 and in the room.
+TOUR = (("forward", 2.2), ("turn", 90), ("forward", 1.0), ("turn", 90), ("forward", 2.2), ("turn", 90),
+        ("forward", 1.0), ("turn", 90), ("arc", 180))
+LINEAR_SPEED, TURN_SPEED = 0.4, 0.8
+SEGMENT_SIM_TIMEOUT = 60.0
+WALL_TIMEOUT = 600.0
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _yaw(orientation) -> float:
+    q = orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class Recorder:
+    """The robot's path from /odom and the lidar's hits from /scan, in the odom frame."""
+
+    def __init__(self):
+        import rospy
+        import tf2_ros
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import LaserScan
+        self.lock = threading.Lock()
+        self.path, self.headings, self.scan_points = [], [], []
+        self.scans = 0
+        self.odometry = None
+        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(120))
+        self.tf_listener = tf2_ros.TransformListener(self.tf_buffer)
+        self.subscribers = [rospy.Subscriber("/odom", Odometry, self._on_odometry, queue_size=50),
+                            rospy.Subscriber("/scan", LaserScan, self._on_scan, queue_size=5)]
+
+    def _on_odometry(self, message):
+        with self.lock:
+            self.odometry = message
+            position = message.pose.pose.position
+            self.path.append((position.x, position.y))
+            self.headings.append(_yaw(message.pose.pose.orientation))
+
+    def _on_scan(self, message):
+        import numpy
+        import rospy
+        import tf2_ros
+        try:
+            transform = self.tf_buffer.lookup_transform("odom", message.header.frame_id, message.header.stamp,
+                                                        rospy.Duration(1.0))
+        except (tf2_ros.LookupException, tf2_ros.ExtrapolationException, tf2_ros.ConnectivityException):
+            return
+        ranges = numpy.asarray(message.ranges)
+        angles = message.angle_min + numpy.arange(len(ranges)) * message.angle_increment
+        hit = numpy.isfinite(ranges)
+        t, q = transform.transform.translation, transform.transform.rotation
+        yaw = _yaw(q)
+        x = ranges[hit] * numpy.cos(angles[hit] + yaw) + t.x
+        y = ranges[hit] * numpy.sin(angles[hit] + yaw) + t.y
+        with self.lock:
+            self.scans += 1
+            self.scan_points.extend(zip(x.tolist(), y.tolist()))
+
+    def pose(self):
+        with self.lock:
+            if self.odometry is None:
+                return None
+            pose = self.odometry.pose.pose
+            return self.odometry.header.stamp.to_sec(), pose.position.x, pose.position.y, _yaw(pose.orientation)
+
+    def distance(self) -> float:
+        with self.lock:
+            return sum(math.dist(a, b) for a, b in zip(self.path, self.path[1:]))
+
+
+class Tour:
+    """Drives the tour closed-loop on odometry and shows progress."""
+
+    def __init__(self, recorder, show_progress):
+        import rospy
+        from geometry_msgs.msg import Twist
+        self.recorder = recorder
+        self.show_progress = show_progress
+        self.twist_type = Twist
+        self.publisher = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
+        self.last_progress = 0.0
+
+    def command(self, linear, angular):
+        twist = self.twist_type()
+        twist.linear.x, twist.angular.z = linear, angular
+        self.publisher.publish(twist)
+
+    def progress(self, final=False):
+        now = time.monotonic()
+        if not final and now - self.last_progress < 0.5:
+            return
+        self.last_progress = now
+        pose = self.recorder.pose()
+        line = "  sim %6.1f s | %5.2f m driven | %4d scans" % (pose[0] if pose else 0.0, self.recorder.distance(),
+                                                                 self.recorder.scans)
+        if self.show_progress:
+            print("\r" + line, end="\n" if final else "", file=sys.stderr, flush=True)
+        elif final:
+            print(line, file=sys.stderr, flush=True)
+
+    def wait(self, done, what):
+        start = self.recorder.pose()[0]
+        wall_deadline = time.monotonic() + WALL_TIMEOUT
+        while True:
+            pose = self.recorder.pose()
+            if done(pose):
+                return
+            if pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
+                raise RuntimeError("the robot did not finish '%s' (stuck at x %.2f, y %.2f)" % (what, pose[1],
+                                                                                             pose[2]))
+            self.progress()
+            time.sleep(0.005)
+
+    def run(self):
+        for kind, amount in TOUR:
+            _, x0, y0, yaw0 = self.recorder.pose()
+            if kind == "forward":
+                self.command(LINEAR_SPEED, 0.0)
+                self.wait(lambda p: math.hypot(p[1] - x0, p[2] - y0) >= amount, "forward %.1f m" % amount)
+            else:
+                target = math.radians(amount)
+                turned = [0.0, yaw0]
+
+                def turned_enough(pose):
+                    turned[0] += math.remainder(pose[3] - turned[1], 2 * math.pi)
+                    turned[1] = pose[3]
+                    return turned[0] >= target
+                # A turn in place, or an arc that keeps moving at a third of the speed.
+                self.command(LINEAR_SPEED / 3 if kind == "arc" else 0.0, TURN_SPEED)
+                self.wait(turned_enough, "%s %d degrees" % (kind, amount))
+        self.command(0.0, 0.0)
+        self.progress(final=True)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="mbot demo", description=__doc__.splitlines()[0])
+    parser.add_argument("--world", default="play_ground", choices=sorted(WORLDS), help="world to tour")
+    parser.add_argument("--gui", action="store_true", help="show the simulator window (needs a DISPLAY)")
+    parser.add_argument("--out", default=os.path.join(os.getcwd(), "out", "demo.png"), help="picture to write")
+    args = parser.parse_args(argv)
+
+    import rospkg
+    world_path = os.path.join(rospkg.RosPack().get_path("mbot_gazebo"), "worlds", WORLDS[args.world])
+    model = os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
+                         "mbot_with_laser_gazebo.xacro")
+    port = _free_port()
+    os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
+    log_dir = os.path.join(os.path.dirname(os.path.abspath(args.out)), "demo_logs")
+    os.makedirs(log_dir, exist_ok=True)
+    os.environ["ROS_LOG_DIR"] = log_dir
+    processes = []
+    started = time.monotonic()
+    try:
+        processes.append(subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL, start_new_session=True))
+        import rosgraph
+        while not rosgraph.is_master_online():
+            time.sleep(0.05)
+        with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
+            processes.append(subprocess.Popen(
+                ["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "world_name:=" + world_path,
+                 "model:=" + model, "gui:=%s" % str(args.gui).lower(), "real_time_factor:=0"],
+                stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True))
+        print("mbot demo: %s world, lidar mbot, as fast as the machine goes (log: %s)"
+              % (args.world, os.path.relpath(log_dir)), file=sys.stderr, flush=True)
+        return tour_and_draw(args, world_path, started)
+    finally:
+        for process in reversed(processes):
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGINT)
+                try:
+                    process.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    os.killpg(process.pid, signal.SIGKILL)
+
+
+def tour_and_draw(args, world_path, started):
+    import rospy
+    from mbot_sim_bridge.core.world import parse_world
+
+    from .demo_plot import draw_demo
+    rospy.init_node("mbot_demo", disable_signals=True)
+    recorder = Recorder()
+    deadline = time.monotonic() + 120
+    while recorder.pose() is None or recorder.scans == 0:
+        if time.monotonic() > deadline:
+            print("mbot demo: no /odom and /scan from the simulator within 120 s (see the log)", file=sys.stderr)
+            return 1
+        time.sleep(0.05)
+    tour = Tour(recorder, show_progress=sys.stderr.isatty())
+    sim_start, wall_start = recorder.pose()[0], time.monotonic()
+    try:
+        tour.run()
+    except RuntimeError as error:
+        print("\nmbot demo: %s" % error, file=sys.stderr)
+        return 1
+    sim_seconds, wall_seconds = recorder.pose()[0] - sim_start, time.monotonic() - wall_start
+    with recorder.lock:
+        path, headings, points = list(recorder.path), list(recorder.headings), list(recorder.scan_points)
+        scans = recorder.scans
+    _, x, y, yaw = recorder.pose()
+    summary = ["distance driven: %.2f m" % recorder.distance(),
+               "tour: %.1f s of sim time in %.1f s of wall time (real-time factor %.1f)"
+               % (sim_seconds, wall_seconds, sim_seconds / wall_seconds),
+               "scans received: %d (%d points)" % (scans, len(points)),
+               "final odometry: x %.3f m, y %.3f m, yaw %.1f deg" % (x, y, math.degrees(yaw))]
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    import numpy
+    draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
+              title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings))
+    for line in summary + ["picture: %s" % os.path.relpath(args.out), "total wall time: %.1f s"
+                           % (time.monotonic() - started)]:
+        print(line)
+    return 0

@@ -1,0 +1,65 @@
+"""The simulator window (PyBullet's GUI) as Gazebo's client shows it: Gazebo colours, camera on the robot."""
+import math
+import time
+
+import pybullet
+
+from .engine import Engine, SpawnedRobot
+from .geometry import yaw
+from .materials import gazebo_material_rgba
+
+# Close enough to see the 0.32 m mbot and what is around it, from behind and above.
+_CAMERA_DISTANCE, _CAMERA_PITCH_DEGREES = 1.2, -30.0
+_FOLLOW_PERIOD_SECONDS = 1.0 / 30.0
+
+
+class Viewer:
+    def __init__(self, engine: Engine):
+        self.engine = engine
+        client = engine.client
+        # A clean view: no side panels and preview windows, as gzclient shows only the scene.
+        client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
+        self.followed = None
+        self._last_follow = 0.0
+
+    def show_robot(self, robot: SpawnedRobot):
+        """Gazebo materials (``<gazebo reference><material>Gazebo/X``) on the links that set one; the first
+        robot shown is the one the camera follows.
+
+        PyBullet colours a link's visuals as a whole, so links lumped together (the course's base_link and
+        laser_link into base_footprint) take the material of the heaviest of them.
+        """
+        client = self.engine.client
+        colours = {}
+        for link in robot.model.links.values():
+            rgba = gazebo_material_rgba(link.gazebo_tag("material") or "")
+            if rgba is None or link.name not in robot.model.lumped_into:
+                continue
+            index = robot.link_index[robot.model.lumped_into[link.name][0]]
+            if index not in colours or link.mass > colours[index][0]:
+                colours[index] = (link.mass, rgba)
+        for index, (_, rgba) in colours.items():
+            client.changeVisualShape(robot.body, index, rgbaColor=rgba)
+        if self.followed is None:
+            self.followed = robot
+            pose = robot.root_pose()
+            client.resetDebugVisualizerCamera(_CAMERA_DISTANCE, math.degrees(yaw(pose.orientation)) - 90.0,
+                                              _CAMERA_PITCH_DEGREES, pose.position)
+
+    def forget_robot(self, robot: SpawnedRobot):
+        if self.followed is robot:
+            self.followed = None
+
+    def follow(self):
+        """Keep the camera on the followed robot, at most 30 times a wall second.
+
+        Only the target moves: distance and angles stay as the user left them with the mouse.
+        """
+        now = time.monotonic()
+        if self.followed is None or now - self._last_follow < _FOLLOW_PERIOD_SECONDS:
+            return
+        self._last_follow = now
+        client = self.engine.client
+        camera = client.getDebugVisualizerCamera()
+        yaw_degrees, pitch_degrees, distance = camera[8], camera[9], camera[10]
+        client.resetDebugVisualizerCamera(distance, yaw_degrees, pitch_degrees, self.followed.root_pose().position)
