@@ -65,9 +65,9 @@ def run_rostest(test_file):
     if result.returncode != 0 or not tests:
         print(output)
     else:
-        # The test nodes print their figures on stderr; show them, not the launch chatter.
-        for block in re.findall(r"\n([^\n]*figures[^\n]*:\n(?:  [^\n]*\n)+)", output):
-            print(block)
+        # The test nodes print their measurements as "figure: ..." lines; show them, not the launch chatter.
+        for figure in re.findall(r"figure: (.*)", output):
+            print("   " + figure)
     total = int(tests[-1]) if tests else 0
     failed = (int(errors[-1]) + int(failures[-1])) if tests else 1
     if result.returncode != 0 and failed == 0:

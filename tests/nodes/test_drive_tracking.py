@@ -27,8 +27,9 @@ class DriveTracking(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join(["", "tracking figures (ground truth, %.0f s after the command, over %.0f s):"
-                         % (SETTLE_SECONDS, MEASURE_SECONDS)] + cls.figures), file=sys.stderr)
+        print("\n".join(["", "figure: tracking, from ground truth %.0f s after each command, over %.0f s:"
+                         % (SETTLE_SECONDS, MEASURE_SECONDS)] + ["figure: " + line for line in cls.figures]),
+              file=sys.stderr)
 
     def steady_motion(self, linear, angular):
         """Reset, command, settle, then measure over a window: (speed along heading, yaw rate, worst tilt, z)."""

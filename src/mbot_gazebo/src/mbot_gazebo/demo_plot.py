@@ -17,10 +17,14 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.patches import Polygon
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Polygon
 
 IMAGE_SIZE = (1000, 750)  # PNG width, height in pixels
 _DPI = 100
+# Axes box: figure fractions across, pixels from the top and bottom; the legend takes the right-hand column.
+_LEFT, _WIDTH = 0.07, 0.65
+_TOP_PX, _BOTTOM_PX, _SUMMARY_LINE_PX = 36, 52, 16
 GROUND_COLOUR = "#eef1e6"
 OBSTACLE_COLOUR = "#7d8590"
 OBSTACLE_EDGE_COLOUR = "#4a5059"
@@ -81,51 +85,52 @@ def draw_demo(world, path_xy, scan_points_xy, out_path: str, title: str = "", su
     obstacles = [np.asarray(shape.outline()) for shape in world.shapes if shape.kind != "plane"]
     obstacles = [outline for outline in obstacles if len(outline) >= 3]
 
-    figure = Figure(figsize=(IMAGE_SIZE[0] / _DPI, IMAGE_SIZE[1] / _DPI), dpi=_DPI, layout="constrained")
+    figure = Figure(figsize=(IMAGE_SIZE[0] / _DPI, IMAGE_SIZE[1] / _DPI), dpi=_DPI)
     canvas = FigureCanvasAgg(figure)
-    summary_height = 0.25 * len(summary_lines)
-    grid = figure.add_gridspec(2 if summary_lines else 1, 1,
-                               height_ratios=[IMAGE_SIZE[1] / _DPI - summary_height, summary_height]
-                               if summary_lines else None)
-    axes = figure.add_subplot(grid[0])
-
+    # A fixed axes box rather than a layout engine: constrained layout moves the box after the equal aspect
+    # has been applied, which leaves the two axes' scales apart by a pixel or so.
+    summary_px = _SUMMARY_LINE_PX * len(summary_lines)
+    bottom_px = _BOTTOM_PX + summary_px
+    box_px = (_WIDTH * IMAGE_SIZE[0], IMAGE_SIZE[1] - _TOP_PX - bottom_px)
+    axes = figure.add_axes([_LEFT, bottom_px / IMAGE_SIZE[1], _WIDTH, box_px[1] / IMAGE_SIZE[1]])
     axes.set_facecolor(GROUND_COLOUR)
+
+    handles = []
     for outline in obstacles:
         axes.add_patch(Polygon(outline, closed=True, facecolor=OBSTACLE_COLOUR, edgecolor=OBSTACLE_EDGE_COLOUR,
                                linewidth=0.8, zorder=1))
-    if obstacles:  # one legend entry for all of them
-        axes.add_patch(Polygon(np.zeros((3, 2)), facecolor=OBSTACLE_COLOUR, edgecolor=OBSTACLE_EDGE_COLOUR,
-                               label="obstacles (SDF collisions)", visible=False))
+    if obstacles:
+        handles.append(Patch(facecolor=OBSTACLE_COLOUR, edgecolor=OBSTACLE_EDGE_COLOUR,
+                             label="obstacles (SDF collisions)"))
     if len(scan):
-        axes.scatter(scan[:, 0], scan[:, 1], s=6, color=SCAN_COLOUR, linewidths=0, zorder=2,
-                     label="lidar hits (%d)" % len(scan))
+        handles.append(axes.scatter(scan[:, 0], scan[:, 1], s=8, color=SCAN_COLOUR, linewidths=0, zorder=2,
+                                    label="lidar hits (%d)" % len(scan)))
+    xlim, ylim = _fit_box(*_frame_limits(path, scan, obstacles), box_px)
     if len(path):
-        axes.plot(path[:, 0], path[:, 1], color=PATH_COLOUR, linewidth=2.5, solid_capstyle="round", zorder=3,
-                  label="driven path (odometry)")
-        axes.plot(*path[0], "o", color=START_COLOUR, markersize=9, zorder=4, label="start")
-        axes.plot(*path[-1], "s", color=END_COLOUR, markersize=8, zorder=4, label="end")
+        handles += axes.plot(path[:, 0], path[:, 1], color=PATH_COLOUR, linewidth=2.5, solid_capstyle="round",
+                             zorder=3, label="driven path (odometry)")
+        handles += axes.plot(*path[0], "o", color=START_COLOUR, markersize=9, zorder=4, label="start")
+        handles += axes.plot(*path[-1], "s", color=END_COLOUR, markersize=8, zorder=4, label="end")
+        if headings is not None and len(headings):
+            length = 0.06 * max(xlim[1] - xlim[0], ylim[1] - ylim[0])
+            handles.append(_heading_arrow(axes, path[-1], float(np.asarray(headings, dtype=float)[-1]), length))
 
-    xlim, ylim = _frame_limits(path, scan, obstacles)
     axes.set_xlim(*xlim)
     axes.set_ylim(*ylim)
-    if len(path) and headings is not None and len(headings):
-        length = 0.06 * max(xlim[1] - xlim[0], ylim[1] - ylim[0])
-        _heading_arrow(axes, path[-1], float(np.asarray(headings, dtype=float)[-1]), length)
-    axes.set_aspect("equal", adjustable="datalim")
+    axes.set_aspect("equal", adjustable="datalim")  # the limits already fit the box; this keeps them equal
     axes.set_xlabel("x [m]")
     axes.set_ylabel("y [m]")
     axes.grid(True, color="white", linewidth=0.8)
     axes.set_axisbelow(True)
-    axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=9)
+    if handles:
+        axes.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=9)
     if title:
         axes.set_title(title)
     if summary_lines:
-        text_axes = figure.add_subplot(grid[1])
-        text_axes.axis("off")
-        text_axes.text(0.0, 1.0, "\n".join(summary_lines), va="top", ha="left", family="monospace", fontsize=9,
-                       transform=text_axes.transAxes)
+        figure.text(_LEFT, (summary_px + _SUMMARY_LINE_PX / 2) / IMAGE_SIZE[1], "\n".join(summary_lines),
+                    va="top", ha="left", family="monospace", fontsize=9)
 
-    # Saving draws the figure, which settles the layout and the equal-aspect limits that the frame reports.
+    # Saving draws the figure, which settles the equal-aspect limits that the frame reports.
     figure.savefig(out_path, dpi=_DPI)
     return _plot_frame(canvas, axes)
 
@@ -135,13 +140,13 @@ def _finite_points(points) -> np.ndarray:
     return array[np.all(np.isfinite(array), axis=1)]
 
 
-def _heading_arrow(axes, position, heading: float, length: float) -> None:
+def _heading_arrow(axes, position, heading: float, length: float) -> Line2D:
+    """An arrow from ``position`` along ``heading``; returns a legend handle for it (annotations have none)."""
     tip = position + length * np.array([np.cos(heading), np.sin(heading)])
     axes.annotate("", xy=tip, xytext=position, zorder=5,
                   arrowprops=dict(arrowstyle="-|>", color=END_COLOUR, linewidth=2.0, mutation_scale=18))
-    # annotate() has no legend entry; an arrow-shaped marker stands in for it.
-    axes.plot([], [], marker=r"$\rightarrow$", linestyle="none", color=END_COLOUR, markersize=12,
-              label="final heading")
+    return Line2D([], [], marker=r"$\rightarrow$", linestyle="none", color=END_COLOUR, markersize=12,
+                  label="final heading")
 
 
 def _frame_limits(path: np.ndarray, scan: np.ndarray, obstacles) -> Tuple[Tuple[float, float], Tuple[float, float]]:
@@ -162,6 +167,16 @@ def _frame_limits(path: np.ndarray, scan: np.ndarray, obstacles) -> Tuple[Tuple[
         low, high = np.zeros(2), np.zeros(2)
     low, high = low - MARGIN, high + MARGIN
     return (float(low[0]), float(high[0])), (float(low[1]), float(high[1]))
+
+
+def _fit_box(xlim, ylim, box_px) -> Tuple[Tuple[float, float], Tuple[float, float]]:
+    """Widen the narrower of the two ranges about its centre so that both have the box's metres per pixel.
+
+    Left to itself, matplotlib's "datalim" adjustment may narrow a range instead, cutting off what was framed.
+    """
+    scale = max((xlim[1] - xlim[0]) / box_px[0], (ylim[1] - ylim[0]) / box_px[1])
+    return tuple((sum(limits) / 2 - scale * size / 2, sum(limits) / 2 + scale * size / 2)
+                 for limits, size in zip((xlim, ylim), box_px))
 
 
 def _plot_frame(canvas: FigureCanvasAgg, axes) -> PlotFrame:

@@ -1,0 +1,170 @@
+"""Each shipped rviz config shows the mbot, and its lidar where the config has one, without TF errors.
+
+rviz runs against the course's lidar launch file (gui:=false) on a private X server with software OpenGL.
+The checks look at the 3D view of a screenshot: the colour of the robot's base from robot_description and
+the LaserScan display's flat colour from the config. MBOT_SCREENSHOT_DIR, if set, receives a copy of each
+screenshot.
+"""
+import glob
+import os
+import shutil
+import subprocess
+import time
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+import rosgraph
+import yaml
+
+from conftest import TESTS, stop, wait_until
+from xvfb import Xvfb
+
+CONFIGS = sorted(glob.glob(os.path.join(TESTS, "..", "src", "mbot_description", "config", "*.rviz")))
+TF_ERRORS = ("TF_OLD_DATA", "TF_REPEATED_DATA", "Lookup would require extrapolation", "No transform from",
+             "Could not transform")
+MIN_ROBOT_PIXELS = 100
+MIN_SCAN_PIXELS = 100
+DRAW_TIMEOUT = 30.0
+
+
+def test_every_config_is_tested():
+    assert {os.path.basename(path) for path in CONFIGS} >= {"mbot.rviz", "mbot_with_laser.rviz"}
+
+
+@pytest.mark.parametrize("config", CONFIGS, ids=os.path.basename)
+def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
+    with open(config) as stream:
+        displays = yaml.safe_load(stream)["Visualization Manager"]
+    background = parse_colour(displays["Global Options"]["Background Color"])
+    scan_colour = laser_scan_colour(displays["Displays"])
+
+    launch("mbot_gazebo", "view_mbot_with_laser_gazebo.launch", "gui:=false")
+    master = rosgraph.Master("/test_rviz", master_uri=ros_env["ROS_MASTER_URI"])
+    wait_until(lambda: published(master) >= {"/odom", "/scan", "/tf", "/tf_static"}, 60,
+               "the simulated mbot's /odom, /scan, /tf and /tf_static")
+    robot_colour = base_link_colour(master.getParam("/robot_description"))
+
+    def drawn(image):
+        view = view_3d(image, background)
+        return (view is not None and colour_count(view, robot_colour) >= MIN_ROBOT_PIXELS
+                and (scan_colour is None or len(scan_pixels_off_robot(view, robot_colour, scan_colour))
+                     >= MIN_SCAN_PIXELS))
+
+    log_path = tmp_path / "rviz.log"
+    screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
+    # HOME: rviz keeps ~/.rviz/persistent_settings, which a test must not touch.
+    environment = dict(ros_env, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+    with Xvfb(tmp_path / "xvfb.log") as server, open(log_path, "w") as log:
+        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"],
+                                env=dict(environment, DISPLAY=server.display), stdin=subprocess.DEVNULL,
+                                stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
+                       "rviz to register with the master")
+            assert rviz.poll() is None, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
+            image = screenshot_when(server, screenshot, drawn, DRAW_TIMEOUT)
+        finally:
+            stop(rviz)
+    if os.environ.get("MBOT_SCREENSHOT_DIR"):
+        os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
+        shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
+
+    where = "(screenshot %s, rviz output %s)" % (screenshot, log_path)
+    assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50, "the screen is blank " + where
+    view = view_3d(image, background)
+    assert view is not None, "no 3D view with the background colour %s %s" % (background, where)
+    assert view.shape[0] > 300 and view.shape[1] > 300, "the 3D view is only %s pixels %s" % (view.shape[:2], where)
+    robot_pixels = colour_count(view, robot_colour)
+    assert robot_pixels >= MIN_ROBOT_PIXELS, "base_link colour %s on %d pixels of the 3D view %s" % (
+        robot_colour, robot_pixels, where)
+    if scan_colour is not None:
+        scan_pixels = len(scan_pixels_off_robot(view, robot_colour, scan_colour))
+        assert scan_pixels >= MIN_SCAN_PIXELS, "LaserScan colour %s on %d pixels away from the robot %s" % (
+            scan_colour, scan_pixels, where)
+    output = log_path.read_text()
+    tf_errors = [line for line in output.splitlines() if any(error in line for error in TF_ERRORS)]
+    assert not tf_errors, "TF errors in rviz's output:\n" + "\n".join(tf_errors[:10])
+
+
+def parse_colour(text):
+    """rviz writes colours as "R; G; B" (0-255)."""
+    return tuple(int(channel) for channel in str(text).split(";"))
+
+
+def laser_scan_colour(displays):
+    """The flat colour of the enabled LaserScan display, or None if the config has none."""
+    scans = [display for display in displays if display["Class"] == "rviz/LaserScan" and display["Enabled"]]
+    if not scans:
+        return None
+    assert scans[0]["Color Transformer"] == "FlatColor", "only a FlatColor LaserScan has a colour to look for"
+    return parse_colour(scans[0]["Color"])
+
+
+def base_link_colour(robot_description):
+    """RGB (0-255) of base_link's visual material, inline or defined at the top of the URDF."""
+    robot = ET.fromstring(robot_description)
+    material = robot.find("link[@name='base_link']/visual/material")
+    colour = material.find("color")
+    if colour is None:
+        colour = robot.find("material[@name='%s']/color" % material.get("name"))
+    return tuple(round(255 * float(value)) for value in colour.get("rgba").split()[:3])
+
+
+def published(master):
+    publishers, _, _ = master.getSystemState()
+    return {topic for topic, nodes in publishers if nodes}
+
+
+def node_registered(master, name):
+    try:
+        master.lookupNode(name)
+    except rosgraph.MasterError:
+        return False
+    return True
+
+
+def screenshot_when(server, path, condition, timeout):
+    """Screenshots until ``condition(image)`` holds or ``timeout`` passes; the last one either way."""
+    deadline = time.monotonic() + timeout
+    image = server.screenshot(path)
+    while not condition(image) and time.monotonic() < deadline:
+        image = server.screenshot(path)
+    return image
+
+
+def view_3d(image, background):
+    """The render panel: the rows and columns that are mostly the configured background colour."""
+    is_background = np.all(image == background, axis=2)
+    rows = np.flatnonzero(is_background.mean(axis=1) > 0.3)
+    columns = np.flatnonzero(is_background.mean(axis=0) > 0.3)
+    if not len(rows) or not len(columns):
+        return None
+    return image[rows[0]:rows[-1] + 1, columns[0]:columns[-1] + 1]
+
+
+def colour_mask(view, colour):
+    """Pixels of ``colour`` under any lighting: the same channel proportions, not too dark."""
+    pixels = view.astype(float)
+    brightest = pixels.max(axis=2, keepdims=True)
+    reference = np.asarray(colour, dtype=float)
+    return (np.all(np.abs(pixels / np.maximum(brightest, 1.0) - reference / reference.max()) < 0.06, axis=2)
+            & (brightest[..., 0] > 0.35 * reference.max()))
+
+
+def colour_count(view, colour):
+    return int(colour_mask(view, colour).sum())
+
+
+def scan_pixels_off_robot(view, robot_colour, scan_colour):
+    """Pixels of the unlit scan colour farther from the robot's centre than twice the robot's own extent.
+
+    The Odometry arrow, drawn on the robot in a similar red, stays within that circle.
+    """
+    robot = np.argwhere(colour_mask(view, robot_colour))
+    scan = np.argwhere(np.all(np.abs(view.astype(int) - scan_colour) <= 10, axis=2))
+    if not len(robot):
+        return scan
+    centre = robot.mean(axis=0)
+    extent = np.linalg.norm(robot - centre, axis=1).max()
+    return scan[np.linalg.norm(scan - centre, axis=1) > 2 * extent]

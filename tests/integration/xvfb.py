@@ -1,0 +1,84 @@
+"""A private X server for GUI tests, and screenshots of it.
+
+Xvfb picks a free display number itself (``-displayfd``) and writes it back once it accepts clients, so
+there is neither a guessed number nor a wait for readiness. Screenshots go through ``xwd`` and ImageMagick.
+"""
+import os
+import select
+import subprocess
+
+import numpy as np
+from PIL import Image
+
+CONVERT = "/usr/bin/convert"  # ImageMagick's, by full path: another program of that name may come first on PATH
+
+
+class Xvfb:
+    """``with Xvfb(log_path) as server:`` runs Xvfb on ``server.display`` (":N") until the block ends."""
+
+    def __init__(self, log_path, screen="1280x800x24", timeout=15.0):
+        self.log_path = log_path
+        self.screen = screen
+        self.timeout = timeout
+        self.display = None
+        self._process = None
+
+    def __enter__(self):
+        read_end, write_end = os.pipe()
+        try:
+            with open(self.log_path, "w") as log:
+                # -br: a black root window, so an empty screen is one flat colour.
+                self._process = subprocess.Popen(
+                    ["Xvfb", "-displayfd", str(write_end), "-screen", "0", self.screen, "-nolisten", "tcp", "-br"],
+                    pass_fds=(write_end,), stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                    start_new_session=True)
+            os.close(write_end)
+            write_end = None
+            self.display = ":" + self._read_display_number(read_end)
+        except BaseException:
+            self._stop()
+            raise
+        finally:
+            os.close(read_end)
+            if write_end is not None:
+                os.close(write_end)
+        return self
+
+    def __exit__(self, *exc_info):
+        self._stop()
+
+    def screenshot(self, png_path) -> np.ndarray:
+        """Save the whole screen as a PNG; returns it as an (height, width, 3) uint8 RGB array."""
+        xwd = subprocess.Popen(["xwd", "-root", "-silent", "-display", self.display], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE)
+        try:
+            convert = subprocess.run([CONVERT, "xwd:-", "png:%s" % png_path], stdin=xwd.stdout,
+                                     capture_output=True, timeout=self.timeout)
+        finally:
+            xwd.stdout.close()
+            xwd_error = xwd.communicate(timeout=self.timeout)[1]
+        if xwd.returncode != 0 or convert.returncode != 0:
+            raise RuntimeError("screenshot of %s failed: %s%s" % (self.display, xwd_error.decode(),
+                                                                   convert.stderr.decode()))
+        with Image.open(png_path) as image:
+            return np.asarray(image.convert("RGB"))
+
+    def _read_display_number(self, read_end) -> str:
+        text = b""
+        while not text.endswith(b"\n"):
+            ready, _, _ = select.select([read_end], [], [], self.timeout)
+            chunk = os.read(read_end, 16) if ready else b""
+            if not chunk:
+                raise RuntimeError("Xvfb did not report a display within %.0f s (exit code %s); see %s"
+                                   % (self.timeout, self._process.poll(), self.log_path))
+            text += chunk
+        return text.decode().strip()
+
+    def _stop(self):
+        if self._process is not None and self._process.poll() is None:
+            self._process.terminate()
+            try:
+                self._process.wait(timeout=self.timeout)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait()
