@@ -1,9 +1,7 @@
 """Bad input gets one clear line naming what is wrong, and no traceback."""
-import os
-
 import pytest
 
-from conftest import TESTS, run
+from ros_processes import run
 
 BAD_DRIVE = """<robot name="lopsided">
   <link name="chassis"><inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/>

@@ -17,7 +17,7 @@ import pytest
 import rosgraph
 import yaml
 
-from conftest import TESTS, stop, wait_until
+from ros_processes import TESTS, stop, wait_until
 from xvfb import Xvfb
 
 CONFIGS = sorted(glob.glob(os.path.join(TESTS, "..", "src", "mbot_description", "config", "*.rviz")))
@@ -26,6 +26,8 @@ TF_ERRORS = ("TF_OLD_DATA", "TF_REPEATED_DATA", "Lookup would require extrapolat
 MIN_ROBOT_PIXELS = 100
 MIN_SCAN_PIXELS = 100
 DRAW_TIMEOUT = 30.0
+# rviz must keep the scene up this long: a TF problem shows as the robot vanishing or as errors in its output.
+STEADY = 3.0
 
 
 def test_every_config_is_tested():
@@ -39,10 +41,10 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
     background = parse_colour(displays["Global Options"]["Background Color"])
     scan_colour = laser_scan_colour(displays["Displays"])
 
-    launch("mbot_gazebo", "view_mbot_with_laser_gazebo.launch", "gui:=false")
+    simulation = launch("mbot_gazebo", "view_mbot_with_laser_gazebo.launch", "gui:=false")
     master = rosgraph.Master("/test_rviz", master_uri=ros_env["ROS_MASTER_URI"])
     wait_until(lambda: published(master) >= {"/odom", "/scan", "/tf", "/tf_static"}, 60,
-               "the simulated mbot's /odom, /scan, /tf and /tf_static")
+               "the simulated mbot's /odom, /scan, /tf and /tf_static (see %s)" % simulation.log_path)
     robot_colour = base_link_colour(master.getParam("/robot_description"))
 
     def drawn(image):
@@ -63,7 +65,7 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
             wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
                        "rviz to register with the master")
             assert rviz.poll() is None, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
-            image = screenshot_when(server, screenshot, drawn, DRAW_TIMEOUT)
+            image = watch(server, screenshot, drawn, DRAW_TIMEOUT, STEADY)
         finally:
             stop(rviz)
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
@@ -124,13 +126,19 @@ def node_registered(master, name):
     return True
 
 
-def screenshot_when(server, path, condition, timeout):
-    """Screenshots until ``condition(image)`` holds or ``timeout`` passes; the last one either way."""
+def watch(server, path, condition, timeout, steady):
+    """Screenshots until ``condition(image)`` has held for ``steady`` seconds or ``timeout`` has passed.
+
+    Returns the last screenshot either way, for the assertions to explain what is missing.
+    """
     deadline = time.monotonic() + timeout
-    image = server.screenshot(path)
-    while not condition(image) and time.monotonic() < deadline:
+    held_since = None
+    while True:
         image = server.screenshot(path)
-    return image
+        now = time.monotonic()
+        held_since = (held_since or now) if condition(image) else None
+        if (held_since is not None and now - held_since >= steady) or now > deadline:
+            return image
 
 
 def view_3d(image, background):

@@ -78,9 +78,8 @@ class Laser(unittest.TestCase):
         ahead = numpy.abs(angles) < 0.3
         # The hit distance along a beam at angle a to the wall's normal is d / cos(a).
         errors = numpy.array(scan.ranges)[ahead] - WALL_DISTANCE / numpy.cos(angles[ahead])
-        print("figure: wall at %.2f m: mean error %.4f m, std %.4f m over %d beams" % (WALL_DISTANCE, errors.mean(),
-                                                                              errors.std(ddof=1), ahead.sum()),
-              file=sys.stderr)
+        print("figure: wall at %.2f m: mean error %.4f m, std %.4f m over %d beams"
+              % (WALL_DISTANCE, errors.mean(), errors.std(ddof=1), ahead.sum()), file=sys.stderr)
         self.assertLess(abs(errors.mean()), 0.005)
         self.assertLess(errors.std(ddof=1), 0.02)
 
@@ -96,7 +95,8 @@ class Laser(unittest.TestCase):
         # The 10 m wall is seen over a span of beams symmetric about its normal; the span's middle is the
         # wall's direction, which noise cannot move the way it moves a single nearest beam.
         angle = angles[numpy.isfinite(ranges)].mean()
-        print("figure: after a +90 degree turn the wall is centred at %.1f degrees" % math.degrees(angle), file=sys.stderr)
+        print("figure: after a +90 degree turn the wall is centred at %.1f degrees" % math.degrees(angle),
+              file=sys.stderr)
         # Beams count counter-clockwise from angle_min, so the wall, now on the robot's right, is at -90 degrees.
         self.assertAlmostEqual(angle, -math.pi / 2, delta=2.5 * scan.angle_increment)
         state.pose.orientation.z, state.pose.orientation.w = 0.0, 1.0

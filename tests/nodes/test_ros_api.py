@@ -69,8 +69,8 @@ class RosApi(unittest.TestCase):
                 joint_senders[name].add(message._connection_header["callerid"])
                 joint_positions[name].append(position)
 
-        subscribers = [rospy.Subscriber("/tf", TFMessage, on_tf), rospy.Subscriber("/joint_states", JointState,
-                                                                                    on_joints)]
+        subscribers = [rospy.Subscriber("/tf", TFMessage, on_tf),
+                       rospy.Subscriber("/joint_states", JointState, on_joints)]
         self.sim.reset_world()
         self.sim.command(0.3, 0.0)
         self.sim.wait_sim_time(2.0)

@@ -115,8 +115,8 @@ class Tour:
             return
         self.last_progress = now
         pose = self.recorder.pose()
-        line = "  sim %6.1f s | %5.2f m driven | %4d scans" % (pose[0] if pose else 0.0, self.recorder.distance(),
-                                                                 self.recorder.scans)
+        line = "  sim %6.1f s | %5.2f m driven | %4d scans" % (
+            pose[0] if pose else 0.0, self.recorder.distance(), self.recorder.scans)
         if self.show_progress:
             print("\r" + line, end="\n" if final else "", file=sys.stderr, flush=True)
         elif final:
@@ -130,8 +130,8 @@ class Tour:
             if done(pose):
                 return
             if pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
-                raise RuntimeError("the robot did not finish '%s' (stuck at x %.2f, y %.2f)" % (what, pose[1],
-                                                                                             pose[2]))
+                raise RuntimeError("the robot did not finish '%s' (stuck at x %.2f, y %.2f)"
+                                   % (what, pose[1], pose[2]))
             self.progress()
             time.sleep(0.005)
 

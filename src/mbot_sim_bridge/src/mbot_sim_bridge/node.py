@@ -9,7 +9,7 @@ import queue
 import sys
 import time
 from concurrent.futures import Future
-from typing import Callable, Dict, List, Optional
+from typing import Callable, Dict, List
 
 import numpy
 import pybullet

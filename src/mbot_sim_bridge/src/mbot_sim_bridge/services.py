@@ -68,8 +68,7 @@ def _resolve_package_uris(xml: str) -> str:
         try:
             return packages.get_path(match.group(1)) + "/"
         except rospkg.ResourceNotFound:
-            raise ModelError("package://%s/ in the model: package '%s' not found" % (match.group(1),
-                                                                                      match.group(1))) from None
+            raise ModelError("package://%s/ in the model: no such package" % match.group(1)) from None
     return re.sub(r"package://([^/]+)/", replace, xml)
 
 

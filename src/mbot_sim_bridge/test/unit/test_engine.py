@@ -7,7 +7,7 @@ import pytest
 from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
 from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.errors import ModelError
-from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy, rpy, yaw
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rpy, yaw
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.world import load_world, parse_world
 

@@ -41,13 +41,15 @@ def test_massless_root_gets_a_negligible_inertial_for_pybullet(mbot_urdf):
 
 def test_caster_detection_is_by_shape_and_joint_not_by_name(mbot_urdf):
     assert parse_robot(mbot_urdf).caster_links({"left_wheel_joint", "right_wheel_joint"}) == ["back_caster_link"]
-    urdf = robot(link("chassis"), link("front_ball", '<sphere radius="0.02"/>'), link("wheel", '<cylinder radius="0.03" length="0.02"/>'),
+    urdf = robot(link("chassis"), link("front_ball", '<sphere radius="0.02"/>'),
+                 link("wheel", '<cylinder radius="0.03" length="0.02"/>'),
                  joint("ball_mount", "fixed", "chassis", "front_ball"), joint("axle", "continuous", "chassis", "wheel"))
     assert parse_robot(urdf).caster_links({"axle"}) == ["front_ball"]
 
 
 def test_explicit_friction_keeps_a_sphere_from_being_treated_as_a_caster():
-    urdf = robot(link("chassis"), link("ball", '<sphere radius="0.02"/>'), joint("mount", "continuous", "chassis", "ball"),
+    urdf = robot(link("chassis"), link("ball", '<sphere radius="0.02"/>'),
+                 joint("mount", "continuous", "chassis", "ball"),
                  '<gazebo reference="ball"><mu1>0.3</mu1><mu2>0.3</mu2></gazebo>')
     assert parse_robot(urdf).caster_links(set()) == []
 

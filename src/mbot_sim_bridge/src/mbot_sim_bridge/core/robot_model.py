@@ -200,7 +200,8 @@ def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Elem
                 if child.tag == "plugin":
                     plugins.append(child)
                 elif isinstance(child.tag, str) and child.tag != "static":
-                    warn_once(_logger, "%s: model-level <gazebo> tag <%s> is not supported; ignored" % (source, child.tag))
+                    warn_once(_logger, "%s: model-level <gazebo> tag <%s> is not supported; ignored"
+                              % (source, child.tag))
             continue
         if reference in links:
             links[reference].gazebo.append(block)
