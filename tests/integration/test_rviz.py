@@ -20,7 +20,7 @@ import yaml
 from ros_processes import TESTS, stop, wait_until
 from xvfb import Xvfb
 
-CONFIGS = sorted(glob.glob(os.path.join(TESTS, "..", "src", "mbot_description", "config", "*.rviz")))
+CONFIGS = sorted(glob.glob(os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config", "*.rviz")))
 TF_ERRORS = ("TF_OLD_DATA", "TF_REPEATED_DATA", "Lookup would require extrapolation", "No transform from",
              "Could not transform")
 MIN_ROBOT_PIXELS = 100
@@ -30,7 +30,7 @@ DRAW_TIMEOUT = 30.0
 STEADY = 3.0
 
 
-def test_every_config_is_tested():
+def test_the_shipped_configs_are_found():
     assert {os.path.basename(path) for path in CONFIGS} >= {"mbot.rviz", "mbot_with_laser.rviz"}
 
 
@@ -55,12 +55,12 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
 
     log_path = tmp_path / "rviz.log"
     screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
-    # HOME: rviz keeps ~/.rviz/persistent_settings, which a test must not touch.
-    environment = dict(ros_env, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
     with Xvfb(tmp_path / "xvfb.log") as server, open(log_path, "w") as log:
-        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"],
-                                env=dict(environment, DISPLAY=server.display), stdin=subprocess.DEVNULL,
-                                stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
+        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                start_new_session=True)
         try:
             wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
                        "rviz to register with the master")

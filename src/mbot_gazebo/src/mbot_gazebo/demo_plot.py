@@ -12,7 +12,7 @@ infinite ground plane or a far-away wall does not shrink the run to a dot.
 """
 import json
 from dataclasses import asdict, dataclass
-from typing import Optional, Sequence, Tuple
+from typing import Sequence, Tuple
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -21,10 +21,6 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
 IMAGE_SIZE = (1000, 750)  # PNG width, height in pixels
-_DPI = 100
-# Axes box: figure fractions across, pixels from the top and bottom; the legend takes the right-hand column.
-_LEFT, _WIDTH = 0.07, 0.65
-_TOP_PX, _BOTTOM_PX, _SUMMARY_LINE_PX = 36, 52, 16
 GROUND_COLOUR = "#eef1e6"
 OBSTACLE_COLOUR = "#7d8590"
 OBSTACLE_EDGE_COLOUR = "#4a5059"
@@ -34,6 +30,11 @@ START_COLOUR = "#2b9348"
 END_COLOUR = "#c1121f"
 NEAR = 1.0  # metres: obstacles this close to the path or a scan point are framed too
 MARGIN = 0.5  # metres around everything framed
+
+_DPI = 100
+# Axes box: figure fractions across, pixels from the top and bottom; the legend takes the right-hand column.
+_LEFT, _WIDTH = 0.07, 0.65
+_TOP_PX, _BOTTOM_PX, _SUMMARY_LINE_PX = 36, 52, 16
 
 
 @dataclass(frozen=True)
@@ -54,11 +55,15 @@ class PlotFrame:
     bottom: float
 
     def to_pixels(self, points_xy) -> np.ndarray:
-        """(N, 2) world points in metres -> (N, 2) float (column, row) in the PNG."""
+        """(N, 2) world points in metres -> (N, 2) float (column, row) in the PNG.
+
+        Pixel column c covers [c, c + 1) and row r covers [r, r + 1): floor() gives the pixel a point is in.
+        """
         points = np.asarray(points_xy, dtype=float).reshape(-1, 2)
-        columns = self.left + (points[:, 0] - self.xlim[0]) / (self.xlim[1] - self.xlim[0]) * (self.right - self.left)
-        rows = self.bottom - (points[:, 1] - self.ylim[0]) / (self.ylim[1] - self.ylim[0]) * (self.bottom - self.top)
-        return np.stack([columns, rows], axis=1)
+        x_fraction = (points[:, 0] - self.xlim[0]) / (self.xlim[1] - self.xlim[0])
+        y_fraction = (points[:, 1] - self.ylim[0]) / (self.ylim[1] - self.ylim[0])
+        return np.stack([self.left + x_fraction * (self.right - self.left),
+                         self.bottom - y_fraction * (self.bottom - self.top)], axis=1)
 
     def save(self, path: str) -> None:
         """Write the frame as JSON, e.g. next to the PNG for a check made by another process."""

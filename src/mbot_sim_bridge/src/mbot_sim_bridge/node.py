@@ -43,6 +43,7 @@ class SimBridgeNode:
         self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
         self.start_paused = _bool_param("~paused", False)
         requested_gui = _bool_param("~gui", False)
+        headless = _bool_param("~headless", False)
         real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
         # Gazebo publishes /clock on every step; from Python that costs more than the step itself, so the
         # bridge defaults to 100 Hz and also publishes right before any plugin output (see README).
@@ -52,9 +53,10 @@ class SimBridgeNode:
 
         world = parse_world(self.world_path, default_model_path())
         self.physics: PhysicsConfig = world.physics
-        self.gui = requested_gui and bool(os.environ.get("DISPLAY"))
+        self.gui = requested_gui and not headless and bool(os.environ.get("DISPLAY"))
         if requested_gui and not self.gui:
-            rospy.loginfo("gui:=true but no DISPLAY is set: running without a window")
+            rospy.loginfo("gui:=true, but %s: running without a window"
+                          % ("headless:=true" if headless else "no DISPLAY is set"))
         self.engine = Engine(self.physics, pybullet.GUI if self.gui else pybullet.DIRECT)
         self.viewer = Viewer(self.engine) if self.gui else None
         self.world = load_world(self.engine.client, world)

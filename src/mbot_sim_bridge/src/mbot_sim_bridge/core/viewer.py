@@ -11,6 +11,8 @@ from .materials import gazebo_material_rgba
 # Close enough to see the 0.32 m mbot and what is around it, from behind and above.
 _CAMERA_DISTANCE, _CAMERA_PITCH_DEGREES = 1.2, -30.0
 _FOLLOW_PERIOD_SECONDS = 1.0 / 30.0
+# The window applies a camera change asynchronously; until then it still reports the old camera.
+_CAMERA_SETTLE_SECONDS = 1.0
 
 
 class Viewer:
@@ -21,6 +23,8 @@ class Viewer:
         client.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0)
         self.followed = None
         self._last_follow = 0.0
+        self._camera = (_CAMERA_DISTANCE, 0.0, _CAMERA_PITCH_DEGREES)  # distance, yaw, pitch (degrees)
+        self._camera_settled_at = 0.0
 
     def show_robot(self, robot: SpawnedRobot):
         """Gazebo materials (``<gazebo reference><material>Gazebo/X``) on the links that set one; the first
@@ -42,9 +46,11 @@ class Viewer:
             client.changeVisualShape(robot.body, index, rgbaColor=rgba)
         if self.followed is None:
             self.followed = robot
-            pose = robot.root_pose()
-            client.resetDebugVisualizerCamera(_CAMERA_DISTANCE, math.degrees(yaw(pose.orientation)) - 90.0,
-                                              _CAMERA_PITCH_DEGREES, pose.position)
+            # Behind the robot, looking along its heading.
+            self._camera = (_CAMERA_DISTANCE, math.degrees(yaw(robot.root_pose().orientation)) - 90.0,
+                            _CAMERA_PITCH_DEGREES)
+            self._camera_settled_at = time.monotonic() + _CAMERA_SETTLE_SECONDS
+            self._aim(robot)
 
     def forget_robot(self, robot: SpawnedRobot):
         if self.followed is robot:
@@ -53,13 +59,17 @@ class Viewer:
     def follow(self):
         """Keep the camera on the followed robot, at most 30 times a wall second.
 
-        Only the target moves: distance and angles stay as the user left them with the mouse.
+        Only the target moves: distance and angles stay as the user leaves them with the mouse.
         """
         now = time.monotonic()
         if self.followed is None or now - self._last_follow < _FOLLOW_PERIOD_SECONDS:
             return
         self._last_follow = now
-        client = self.engine.client
-        camera = client.getDebugVisualizerCamera()
-        yaw_degrees, pitch_degrees, distance = camera[8], camera[9], camera[10]
-        client.resetDebugVisualizerCamera(distance, yaw_degrees, pitch_degrees, self.followed.root_pose().position)
+        if now > self._camera_settled_at:
+            camera = self.engine.client.getDebugVisualizerCamera()
+            self._camera = (camera[10], camera[8], camera[9])
+        self._aim(self.followed)
+
+    def _aim(self, robot: SpawnedRobot):
+        distance, yaw_degrees, pitch_degrees = self._camera
+        self.engine.client.resetDebugVisualizerCamera(distance, yaw_degrees, pitch_degrees, robot.root_pose().position)

@@ -1,0 +1,45 @@
+"""The simulator window: PyBullet's GUI opens on a (virtual) display and shows the robot in its Gazebo
+colours; without a display, or with headless:=true, the simulator runs without one and says so once."""
+import os
+
+import numpy as np
+import pytest
+
+from ros_processes import run, wait_until
+from xvfb import Xvfb
+
+MIN_ROBOT_PIXELS = 200
+
+
+def gazebo_blue_pixels(image) -> int:
+    """Pixels of the base's Gazebo/Blue (pure blue, lit and shaded), which nothing else in the scene uses."""
+    red, green, blue = (image[:, :, channel].astype(int) for channel in range(3))
+    return int(np.count_nonzero((blue > 90) & (red < 40) & (green < 40)))
+
+
+def spawned(ros_env):
+    return "mbot" in run(["rosservice", "call", "/gazebo/get_world_properties"], ros_env).stdout
+
+
+def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):
+    screenshot = tmp_path / "pybullet_gui.png"
+    with Xvfb(tmp_path / "xvfb.log") as server:
+        ros_env.update(DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1")
+        simulation = launch("mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=true")
+        wait_until(lambda: spawned(ros_env), 90, "the mbot to spawn (see %s)" % simulation.log_path)
+        wait_until(lambda: gazebo_blue_pixels(server.screenshot(screenshot)) >= MIN_ROBOT_PIXELS, 60,
+                   "the blue mbot in the window (screenshot %s)" % screenshot)
+        if os.environ.get("MBOT_SCREENSHOT_DIR"):
+            server.screenshot(os.path.join(os.environ["MBOT_SCREENSHOT_DIR"], "pybullet_gui.png"))
+    assert "GUI" in simulation.log_path.read_text()
+
+
+@pytest.mark.parametrize("arguments, reason", [(("gui:=true",), "no DISPLAY is set"),
+                                                (("gui:=true", "headless:=true"), "headless:=true")])
+def test_no_window_without_a_display_or_when_headless(ros_env, launch, arguments, reason):
+    ros_env.pop("DISPLAY", None)
+    simulation = launch("mbot_sim_bridge", "empty_world.launch", *arguments)
+    wait_until(lambda: "running without a window" in simulation.log_path.read_text(), 60, "the bridge's notice")
+    notices = [line for line in simulation.log_path.read_text().splitlines() if "without a window" in line]
+    assert len(notices) == 1 and reason in notices[0], notices
+    assert "headless" in simulation.log_path.read_text().split("world ")[-1]
