@@ -47,21 +47,26 @@ class Xvfb:
     def __exit__(self, *exc_info):
         self._stop()
 
-    def screenshot(self, png_path) -> np.ndarray:
-        """Save the whole screen as a PNG; returns it as an (height, width, 3) uint8 RGB array."""
-        xwd = subprocess.Popen(["xwd", "-root", "-silent", "-display", self.display], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE)
-        try:
-            convert = subprocess.run([CONVERT, "xwd:-", "png:%s" % png_path], stdin=xwd.stdout,
-                                     capture_output=True, timeout=self.timeout)
-        finally:
-            xwd.stdout.close()
-            xwd_error = xwd.communicate(timeout=self.timeout)[1]
-        if xwd.returncode != 0 or convert.returncode != 0:
-            raise RuntimeError("screenshot of %s failed: %s%s" % (self.display, xwd_error.decode(),
-                                                                   convert.stderr.decode()))
-        with Image.open(png_path) as image:
-            return np.asarray(image.convert("RGB"))
+    def screenshot(self, png_path, attempts=3) -> np.ndarray:
+        """Save the whole screen as a PNG; returns it as an (height, width, 3) uint8 RGB array.
+
+        xwd reads every window whose visual differs from the root's (an OpenGL view) on its own, so a window
+        destroyed meanwhile, as happens while an application starts, fails the read: it is tried again.
+        """
+        for _ in range(attempts):
+            xwd = subprocess.Popen(["xwd", "-root", "-silent", "-display", self.display], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE)
+            try:
+                convert = subprocess.run([CONVERT, "xwd:-", "png:%s" % png_path], stdin=xwd.stdout,
+                                         capture_output=True, timeout=self.timeout)
+            finally:
+                xwd.stdout.close()
+                xwd_error = xwd.communicate(timeout=self.timeout)[1]
+            if xwd.returncode == 0 and convert.returncode == 0:
+                with Image.open(png_path) as image:
+                    return np.asarray(image.convert("RGB"))
+        raise RuntimeError("screenshot of %s failed %d times, last: %s%s" % (
+            self.display, attempts, xwd_error.decode(), convert.stderr.decode()))
 
     def _read_display_number(self, read_end) -> str:
         text = b""

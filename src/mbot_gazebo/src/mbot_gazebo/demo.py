@@ -16,11 +16,14 @@ import time
 
 WORLDS = {"play_ground": "playground.world", "playground": "playground.world", "room": "room.world",
           "empty": "empty.world"}
-# The tour, in the robot's own terms: (metres forward, or a turn in place in degrees counter-clockwise).
-# It stays inside the play ground's free rectangle x -1.5..3.5, y -1.5..1.5 and in the room.
+# The tour, in the robot's own terms: metres forward, or degrees counter-clockwise turned in place or on an
+# arc (turns of at most 90 degrees, so the heading error never wraps). It stays inside the play ground's
+# free rectangle (x -1.5..3.5, y -1.5..1.5) and inside the room.
 TOUR = (("forward", 2.2), ("turn", 90), ("forward", 1.0), ("turn", 90), ("forward", 2.2), ("turn", 90),
-        ("forward", 1.0), ("turn", 90), ("arc", 180))
-LINEAR_SPEED, TURN_SPEED = 0.4, 0.8
+        ("forward", 1.0), ("turn", 90), ("arc", 90), ("arc", 90))
+LINEAR_SPEED, TURN_SPEED, MIN_TURN_SPEED = 0.4, 0.8, 0.1
+HEADING_GAIN = 2.0  # rad/s of command per rad of heading error
+PROGRESS_PERIOD = 0.5  # wall seconds between progress updates (2 s when the output is not a terminal)
 SEGMENT_SIM_TIMEOUT = 60.0
 WALL_TIMEOUT = 600.0
 
@@ -95,11 +98,11 @@ class Recorder:
 class Tour:
     """Drives the tour closed-loop on odometry and shows progress."""
 
-    def __init__(self, recorder, show_progress):
+    def __init__(self, recorder, on_terminal):
         import rospy
         from geometry_msgs.msg import Twist
         self.recorder = recorder
-        self.show_progress = show_progress
+        self.on_terminal = on_terminal
         self.twist_type = Twist
         self.publisher = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
         self.last_progress = 0.0
@@ -111,15 +114,16 @@ class Tour:
 
     def progress(self, final=False):
         now = time.monotonic()
-        if not final and now - self.last_progress < 0.5:
+        if not final and now - self.last_progress < (PROGRESS_PERIOD if self.on_terminal else 4 * PROGRESS_PERIOD):
             return
         self.last_progress = now
         pose = self.recorder.pose()
         line = "  sim %6.1f s | %5.2f m driven | %4d scans" % (
             pose[0] if pose else 0.0, self.recorder.distance(), self.recorder.scans)
-        if self.show_progress:
+        # On a terminal one line updates in place; in a log, a line every few seconds.
+        if self.on_terminal:
             print("\r" + line, end="\n" if final else "", file=sys.stderr, flush=True)
-        elif final:
+        else:
             print(line, file=sys.stderr, flush=True)
 
     def wait(self, done, what):
@@ -136,22 +140,25 @@ class Tour:
             time.sleep(0.005)
 
     def run(self):
+        _, _, _, heading = self.recorder.pose()
         for kind, amount in TOUR:
-            _, x0, y0, yaw0 = self.recorder.pose()
+            _, x0, y0, _ = self.recorder.pose()
             if kind == "forward":
-                self.command(LINEAR_SPEED, 0.0)
-                self.wait(lambda p: math.hypot(p[1] - x0, p[2] - y0) >= amount, "forward %.1f m" % amount)
+                def forward(pose):
+                    # Hold the heading the last turn ended on, so the legs come out straight.
+                    self.command(LINEAR_SPEED, HEADING_GAIN * math.remainder(heading - pose[3], 2 * math.pi))
+                    return math.hypot(pose[1] - x0, pose[2] - y0) >= amount
+                self.wait(forward, "forward %.1f m" % amount)
             else:
-                target = math.radians(amount)
-                turned = [0.0, yaw0]
+                heading += math.radians(amount)
+                linear = LINEAR_SPEED / 3 if kind == "arc" else 0.0
 
-                def turned_enough(pose):
-                    turned[0] += math.remainder(pose[3] - turned[1], 2 * math.pi)
-                    turned[1] = pose[3]
-                    return turned[0] >= target
-                # A turn in place, or an arc that keeps moving at a third of the speed.
-                self.command(LINEAR_SPEED / 3 if kind == "arc" else 0.0, TURN_SPEED)
-                self.wait(turned_enough, "%s %d degrees" % (kind, amount))
+                def turn(pose):
+                    # Slow down towards the target heading: the wheels' ramp would carry a full-speed turn past it.
+                    remaining = math.remainder(heading - pose[3], 2 * math.pi)
+                    self.command(linear, max(MIN_TURN_SPEED, min(TURN_SPEED, HEADING_GAIN * remaining)))
+                    return remaining < math.radians(1.0)
+                self.wait(turn, "%s %d degrees" % (kind, amount))
         self.command(0.0, 0.0)
         self.progress(final=True)
 
@@ -199,6 +206,7 @@ def main(argv=None):
 
 
 def tour_and_draw(args, world_path, started):
+    import numpy
     import rospy
     from mbot_sim_bridge.core.world import parse_world
 
@@ -211,7 +219,7 @@ def tour_and_draw(args, world_path, started):
             print("mbot demo: no /odom and /scan from the simulator within 120 s (see the log)", file=sys.stderr)
             return 1
         time.sleep(0.05)
-    tour = Tour(recorder, show_progress=sys.stderr.isatty())
+    tour = Tour(recorder, on_terminal=sys.stderr.isatty())
     sim_start, wall_start = recorder.pose()[0], time.monotonic()
     try:
         tour.run()
@@ -229,9 +237,13 @@ def tour_and_draw(args, world_path, started):
                "scans received: %d (%d points)" % (scans, len(points)),
                "final odometry: x %.3f m, y %.3f m, yaw %.1f deg" % (x, y, math.degrees(yaw))]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    import numpy
-    draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
-              title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings))
+    frame = draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
+                      title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings))
+    # Beside the picture: the recorded odometry and where the plot sits in the PNG, so the two can be compared.
+    stem = os.path.splitext(args.out)[0]
+    numpy.savetxt(stem + "_odometry.csv", numpy.column_stack([path, headings]), delimiter=",",
+                  header="x_m,y_m,yaw_rad", comments="")
+    frame.save(stem + "_frame.json")
     for line in summary + ["picture: %s" % os.path.relpath(args.out), "total wall time: %.1f s"
                            % (time.monotonic() - started)]:
         print(line)
