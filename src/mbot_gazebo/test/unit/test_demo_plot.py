@@ -6,7 +6,7 @@ import pytest
 from matplotlib.colors import to_rgb
 from PIL import Image
 
-from mbot_gazebo.demo_plot import (IMAGE_SIZE, OBSTACLE_COLOUR, PATH_COLOUR, SCAN_COLOUR, PlotFrame, draw_demo)
+from mbot_gazebo.demo_plot import IMAGE_SIZE, OBSTACLE_COLOUR, PATH_COLOUR, SCAN_COLOUR, PlotFrame, draw_demo
 from mbot_sim_bridge.core.world import parse_world
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
