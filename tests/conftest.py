@@ -1,10 +1,8 @@
 """pytest fixtures for tests that need ROS: a private master on a free port, roslaunch processes."""
-import os
 import subprocess
 
 import pytest
-
-from ros_processes import free_port, master_answers, stop, wait_until
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 
 # rostest nodes: run by the .test files, not collected by pytest.
 collect_ignore = ["nodes"]
@@ -13,16 +11,8 @@ collect_ignore = ["nodes"]
 @pytest.fixture
 def ros_env(tmp_path):
     """An environment whose ROS_MASTER_URI points at a master of its own, stopped after the test."""
-    environment = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(), ROS_LOG_DIR=str(tmp_path),
-                       PYTHONUNBUFFERED="1")
-    port = environment["ROS_MASTER_URI"].rsplit(":", 1)[1]
-    master = subprocess.Popen(["rosmaster", "--core", "-p", port], env=environment, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, start_new_session=True)
-    try:
-        wait_until(lambda: master_answers(environment), 30, "the ROS master")
-        yield environment
-    finally:
-        stop(master)
+    with PrivateMaster() as master:
+        yield dict(master.environment, ROS_LOG_DIR=str(tmp_path), PYTHONUNBUFFERED="1")
 
 
 @pytest.fixture
@@ -44,4 +34,4 @@ def launch(ros_env, tmp_path):
 
     yield start
     for process in processes:
-        stop(process)
+        stop_process_group(process)

@@ -34,8 +34,10 @@ def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):
     assert "GUI" in simulation.log_path.read_text()
 
 
-@pytest.mark.parametrize("arguments, reason", [(("gui:=true",), "no DISPLAY is set"),
-                                                (("gui:=true", "headless:=true"), "headless:=true")])
+@pytest.mark.parametrize("arguments, reason", [
+    (("gui:=true",), "no DISPLAY is set"),
+    (("gui:=true", "headless:=true"), "headless:=true"),
+])
 def test_no_window_without_a_display_or_when_headless(ros_env, launch, arguments, reason):
     ros_env.pop("DISPLAY", None)
     simulation = launch("mbot_sim_bridge", "empty_world.launch", *arguments)

@@ -16,8 +16,9 @@ import numpy as np
 import pytest
 import rosgraph
 import yaml
+from mbot_sim_bridge.processes import stop_process_group
 
-from ros_processes import TESTS, stop, wait_until
+from ros_processes import TESTS, wait_until
 from xvfb import Xvfb
 
 CONFIGS = sorted(glob.glob(os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config", "*.rviz")))
@@ -67,7 +68,7 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
             assert rviz.poll() is None, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
             image = watch(server, screenshot, drawn, DRAW_TIMEOUT, STEADY)
         finally:
-            stop(rviz)
+            stop_process_group(rviz)
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
         shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])

@@ -8,11 +8,14 @@ cost of one lidar scan (bench_lidar.py).
 """
 import argparse
 import os
-import signal
-import socket
 import subprocess
 import sys
 import time
+
+import rospy
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
@@ -48,51 +51,33 @@ def raw_pybullet_rtf(sim_seconds: float) -> float:
     return sim_seconds / elapsed
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 def bridge_figures(wall_seconds: float):
-    """(real-time factor, seconds from roslaunch to the first /odom) with every topic subscribed."""
-    port = _free_port()
-    os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
-    master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL, start_new_session=True)
-    launch = None
-    try:
-        import rosgraph
-        import rospy
-        from nav_msgs.msg import Odometry
-        from rosgraph_msgs.msg import Clock
-        while not rosgraph.is_master_online():
-            time.sleep(0.05)
+    """(real-time factor, seconds from roslaunch to the first /odom, topics subscribed), every topic subscribed."""
+    with PrivateMaster() as master:
+        os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
         rospy.init_node("bench_bridge", disable_signals=True)
         started = time.monotonic()
         launch = subprocess.Popen(["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=false",
                                    "real_time_factor:=0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                   start_new_session=True)
-        rospy.wait_for_message("/odom", Odometry, timeout=120)
-        first_odom = time.monotonic() - started
-        clock = []
-        subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
-                                                                                m.clock.to_sec())))]
-        # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
-        subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
-                        for topic, _ in rospy.get_published_topics() if topic != "/clock"]
-        time.sleep(1.0)  # let every subscription connect before the measured window
-        window_start = len(clock)
-        time.sleep(wall_seconds)
-        (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
-        for subscriber in subscribers:
-            subscriber.unregister()
-        return (sim1 - sim0) / (wall1 - wall0), first_odom, len(subscribers)
-    finally:
-        for process in (launch, master):
-            if process is not None and process.poll() is None:
-                os.killpg(process.pid, signal.SIGINT)
-                process.wait(timeout=30)
+        try:
+            rospy.wait_for_message("/odom", Odometry, timeout=120)
+            first_odom = time.monotonic() - started
+            clock = []
+            subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
+                                                                                    m.clock.to_sec())))]
+            # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
+            subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
+                            for topic, _ in rospy.get_published_topics() if topic != "/clock"]
+            time.sleep(1.0)  # let every subscription connect before the measured window
+            window_start = len(clock)
+            time.sleep(wall_seconds)
+            (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
+            for subscriber in subscribers:
+                subscriber.unregister()
+            return (sim1 - sim0) / (wall1 - wall0), first_odom, len(subscribers)
+        finally:
+            stop_process_group(launch)
 
 
 def main():

@@ -7,12 +7,22 @@ the same at any speed), records /odom and /scan (through TF into odom), and writ
 import argparse
 import math
 import os
-import signal
-import socket
 import subprocess
 import sys
 import threading
 import time
+
+import numpy
+import rospkg
+import rospy
+import tf2_ros
+from geometry_msgs.msg import Twist
+from mbot_sim_bridge.core.world import parse_world
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+
+from .demo_plot import draw_demo
 
 WORLDS = {"play_ground": "playground.world", "playground": "playground.world", "room": "room.world",
           "empty": "empty.world"}
@@ -28,12 +38,6 @@ SEGMENT_SIM_TIMEOUT = 60.0
 WALL_TIMEOUT = 600.0
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 def _yaw(orientation) -> float:
     q = orientation
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
@@ -43,10 +47,6 @@ class Recorder:
     """The robot's path from /odom and the lidar's hits from /scan, in the odom frame."""
 
     def __init__(self):
-        import rospy
-        import tf2_ros
-        from nav_msgs.msg import Odometry
-        from sensor_msgs.msg import LaserScan
         self.lock = threading.Lock()
         self.path, self.headings, self.scan_points = [], [], []
         self.scans = 0
@@ -64,9 +64,6 @@ class Recorder:
             self.headings.append(_yaw(message.pose.pose.orientation))
 
     def _on_scan(self, message):
-        import numpy
-        import rospy
-        import tf2_ros
         try:
             transform = self.tf_buffer.lookup_transform("odom", message.header.frame_id, message.header.stamp,
                                                         rospy.Duration(1.0))
@@ -99,16 +96,13 @@ class Tour:
     """Drives the tour closed-loop on odometry and shows progress."""
 
     def __init__(self, recorder, on_terminal):
-        import rospy
-        from geometry_msgs.msg import Twist
         self.recorder = recorder
         self.on_terminal = on_terminal
-        self.twist_type = Twist
         self.publisher = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
         self.last_progress = 0.0
 
     def command(self, linear, angular):
-        twist = self.twist_type()
+        twist = Twist()
         twist.linear.x, twist.angular.z = linear, angular
         self.publisher.publish(twist)
 
@@ -170,47 +164,29 @@ def main(argv=None):
     parser.add_argument("--out", default=os.path.join(os.getcwd(), "out", "demo.png"), help="picture to write")
     args = parser.parse_args(argv)
 
-    import rospkg
     world_path = os.path.join(rospkg.RosPack().get_path("mbot_gazebo"), "worlds", WORLDS[args.world])
     model = os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
                          "mbot_with_laser_gazebo.xacro")
-    port = _free_port()
-    os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
     log_dir = os.path.join(os.path.dirname(os.path.abspath(args.out)), "demo_logs")
     os.makedirs(log_dir, exist_ok=True)
-    os.environ["ROS_LOG_DIR"] = log_dir
-    processes = []
     started = time.monotonic()
-    try:
-        processes.append(subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
-                                          stderr=subprocess.DEVNULL, start_new_session=True))
-        import rosgraph
-        while not rosgraph.is_master_online():
-            time.sleep(0.05)
+    with PrivateMaster() as master:
+        # This process talks to the private master too (rospy reads the environment at init_node).
+        os.environ.update(ROS_MASTER_URI=master.uri, ROS_LOG_DIR=log_dir)
         with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
-            processes.append(subprocess.Popen(
+            simulation = subprocess.Popen(
                 ["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "world_name:=" + world_path,
                  "model:=" + model, "gui:=%s" % str(args.gui).lower(), "real_time_factor:=0"],
-                stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True))
-        print("mbot demo: %s world, lidar mbot, as fast as the machine goes (log: %s)"
-              % (args.world, os.path.relpath(log_dir)), file=sys.stderr, flush=True)
-        return tour_and_draw(args, world_path, started)
-    finally:
-        for process in reversed(processes):
-            if process.poll() is None:
-                os.killpg(process.pid, signal.SIGINT)
-                try:
-                    process.wait(timeout=20)
-                except subprocess.TimeoutExpired:
-                    os.killpg(process.pid, signal.SIGKILL)
+                env=os.environ, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            print("mbot demo: %s world, lidar mbot, as fast as the machine goes (log: %s)"
+                  % (args.world, os.path.relpath(log_dir)), file=sys.stderr, flush=True)
+            return tour_and_draw(args, world_path, started)
+        finally:
+            stop_process_group(simulation)
 
 
 def tour_and_draw(args, world_path, started):
-    import numpy
-    import rospy
-    from mbot_sim_bridge.core.world import parse_world
-
-    from .demo_plot import draw_demo
     rospy.init_node("mbot_demo", disable_signals=True)
     recorder = Recorder()
     deadline = time.monotonic() + 120

@@ -5,31 +5,16 @@ import subprocess
 import sys
 
 import numpy as np
-import pybullet
 import pytest
 from PIL import Image
-from pybullet_utils.bullet_client import BulletClient
 
 from mbot_gazebo.floorplan import FloorPlanError, load_floor_plan, main, merge_cells, world_sdf
-from mbot_sim_bridge.core.log import forget_warnings
 from mbot_sim_bridge.core.world import load_world, parse_world
 
 PACKAGE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 REPO = os.path.abspath(os.path.join(PACKAGE, "..", ".."))
 BUILD_WORLD = os.path.join(PACKAGE, "scripts", "build_world")
 ROOM_PLAN = os.path.join(PACKAGE, "floorplans", "room.yaml")
-
-
-@pytest.fixture
-def client():
-    bullet = BulletClient(connection_mode=pybullet.DIRECT)
-    yield bullet
-    bullet.disconnect()
-
-
-@pytest.fixture(autouse=True)
-def fresh_warnings():
-    forget_warnings()
 
 
 def build_and_load(tmp_path, plan_text, client, caplog):

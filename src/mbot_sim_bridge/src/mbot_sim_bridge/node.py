@@ -69,7 +69,6 @@ class SimBridgeNode:
         self.clock_publisher = loop_publisher("/clock", Clock)
         self.clock_timer = UpdateTimer(clock_frequency)
         self.tf_broadcaster = TransformBroadcaster()
-        self.api = GazeboRosApi(self)
         self.plugins: Dict[str, List[BridgePlugin]] = {}
         self._requests: "queue.Queue[tuple]" = queue.Queue()
         self._pace_wall_start = self._pace_sim_start = 0.0
@@ -81,6 +80,8 @@ class SimBridgeNode:
                       self.real_time_factor or "0 (as fast as possible)",
                       "every step" if clock_frequency <= 0 else "at %.0f Hz" % clock_frequency,
                       "paused" if self.paused else "running", "GUI" if self.gui else "headless")
+        # Last: its services take calls at once, from other threads, and those use everything above.
+        self.api = GazeboRosApi(self)
 
     # -- called from ROS threads -------------------------------------------------------------------------
     def call_in_loop(self, function: Callable, timeout: float = 30.0):

@@ -17,11 +17,3 @@ def expand_xacro(relative_path: str) -> str:
 def mbot_urdf() -> str:
     """The course's Gazebo mbot (mbot_gazebo.xacro), unchanged."""
     return expand_xacro("urdf/gazebo/mbot_gazebo.xacro")
-
-
-@pytest.fixture(autouse=True)
-def fresh_warnings():
-    """Each test sees its own once-only warnings."""
-    from mbot_sim_bridge.core.log import forget_warnings
-    forget_warnings()
-    yield

@@ -12,7 +12,6 @@ from pybullet_utils.bullet_client import BulletClient
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
 from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig, parse_ray_sensor
-from mbot_sim_bridge.core.log import forget_warnings
 
 # The tutorial's rplidar block, as lidar_gazebo.xacro expands it.
 RPLIDAR = """
@@ -95,18 +94,6 @@ def add_robot(client, group: int) -> int:
     for link in (-1, 0):
         client.setCollisionFilterGroupMask(body, link, group, -1)
     return body
-
-
-@pytest.fixture
-def client():
-    bullet = BulletClient(connection_mode=pybullet.DIRECT)
-    yield bullet
-    bullet.disconnect()
-
-
-@pytest.fixture(autouse=True)
-def fresh_warnings():
-    forget_warnings()
 
 
 def scan(client, config, pose=IDENTITY, mask=-1, seed=0):

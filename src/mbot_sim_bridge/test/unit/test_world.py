@@ -8,7 +8,6 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pybullet
 import pytest
-from pybullet_utils.bullet_client import BulletClient
 
 from mbot_sim_bridge.core.errors import WorldError
 from mbot_sim_bridge.core.geometry import yaw
@@ -22,13 +21,6 @@ TEST_MODEL_PATH = [os.path.join(TEST_WORLDS, "models")]
 REPO_WORLDS = os.path.abspath(os.path.join(HERE, "..", "..", "..", "..", "worlds"))
 SHIPPED_WORLDS = sorted(glob.glob(os.path.join(REPO_WORLDS, "*.world")))
 GRAVITY = 9.8
-
-
-@pytest.fixture
-def client():
-    bullet = BulletClient(connection_mode=pybullet.DIRECT)
-    yield bullet
-    bullet.disconnect()
 
 
 @pytest.fixture
