@@ -1,8 +1,8 @@
 """Wall time of one 360-beam rplidar scan in a small PyBullet world (DIRECT mode).
 
 The world is a 10 m × 10 m walled room with a few boxes and a robot-sized body carrying the sensor, whose
-collision group is filtered out as the bridge does. Prints the mean and the 95th percentile of a full
-LaserScanner.scan(), then the mean of the bare rayTestBatch call inside it, one figure per line.
+collision group is filtered out as the bridge does. Prints the median, mean and 95th percentile of a full
+LaserScanner.scan(), then the median of the bare rayTestBatch call inside it, one figure per line.
 
     PYTHONPATH=src/mbot_sim_bridge/src .venv/bin/python src/mbot_sim_bridge/bench/bench_lidar.py
 """
@@ -112,9 +112,10 @@ def main():
         ray_seconds[i] = time.perf_counter() - start
     client.disconnect()
     beams = RPLIDAR.range_count
+    print(f"lidar scan ({beams} beams) median: {np.median(seconds) * 1e3:.3f} ms")
     print(f"lidar scan ({beams} beams) mean: {seconds.mean() * 1e3:.3f} ms")
     print(f"lidar scan ({beams} beams) p95: {np.percentile(seconds, 95) * 1e3:.3f} ms")
-    print(f"rayTestBatch alone ({beams} rays) mean: {ray_seconds.mean() * 1e3:.3f} ms")
+    print(f"rayTestBatch alone ({beams} rays) median: {np.median(ray_seconds) * 1e3:.3f} ms")
 
 
 if __name__ == "__main__":
