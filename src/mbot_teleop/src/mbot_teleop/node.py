@@ -4,6 +4,7 @@ import collections
 import math
 import signal
 import sys
+import warnings
 
 import rospy
 from geometry_msgs.msg import Twist
@@ -23,9 +24,6 @@ DEFAULT_TURN = 1.0  # rad/s
 DEFAULT_KEY_TIMEOUT = 0.5  # s
 # The course reprints the help with every 15th speed line, so the keys stay on screen.
 HELP_EVERY = 15
-# Keys typed ahead are served one per cycle without pause, and rospy's sender thread
-# can fall a dozen messages behind such a burst; the queue keeps every cycle's command.
-QUEUE_SIZE = 100
 
 Params = collections.namedtuple('Params', 'speed speed_from turn turn_from key_timeout')
 
@@ -112,7 +110,12 @@ def main():
         rospy.logfatal('%s: %s', NODE_NAME, error)
         rospy.signal_shutdown('bad parameter')
         return 1
-    publisher = rospy.Publisher('cmd_vel', Twist, queue_size=QUEUE_SIZE)
+    # Synchronous (queue_size=None): each Twist is on the wire when publish() returns, so keys typed ahead
+    # are never dropped and the zero Twist on exit is sent before the node shuts down. rospy warns about
+    # that choice, which here is deliberate.
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', SyntaxWarning)
+        publisher = rospy.Publisher('cmd_vel', Twist, queue_size=None)
     rospy.loginfo('%s: speed %g m/s (%s), turn %g rad/s (%s), key_timeout %g s, publishing on %s',
                   NODE_NAME, params.speed, params.speed_from, params.turn, params.turn_from,
                   params.key_timeout, publisher.resolved_name)
