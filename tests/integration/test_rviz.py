@@ -29,6 +29,7 @@ MIN_SCAN_PIXELS = 100
 DRAW_TIMEOUT = 30.0
 # rviz must keep the scene up this long: a TF problem shows as the robot vanishing or as errors in its output.
 STEADY = 3.0
+RVIZ_ATTEMPTS = 2
 
 
 def test_the_shipped_configs_are_found():
@@ -54,21 +55,30 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
                 and (scan_colour is None or len(scan_pixels_off_robot(view, robot_colour, scan_colour))
                      >= MIN_SCAN_PIXELS))
 
-    log_path = tmp_path / "rviz.log"
     screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
-    with Xvfb(tmp_path / "xvfb.log") as server, open(log_path, "w") as log:
+    with Xvfb(tmp_path / "xvfb.log") as server:
         # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
         environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
-        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
-                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                start_new_session=True)
-        try:
-            wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
-                       "rviz to register with the master")
-            assert rviz.poll() is None, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
-            image = watch(server, screenshot, drawn, DRAW_TIMEOUT, STEADY)
-        finally:
-            stop_process_group(rviz)
+        for attempt in range(1, RVIZ_ATTEMPTS + 1):
+            log_path = tmp_path / ("rviz-%d.log" % attempt)
+            with open(log_path, "w") as log:
+                rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+                                        stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                        start_new_session=True)
+            try:
+                wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
+                           "rviz to register with the master")
+                image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image),
+                              DRAW_TIMEOUT, STEADY)
+                crashed = rviz.poll() is not None
+            finally:
+                stop_process_group(rviz)
+            if not crashed:
+                break
+            # rviz 1.14 sometimes aborts in OGRE's start-up under software OpenGL (std::bad_alloc); that is
+            # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
+            print("rviz exited with %s on start %d:\n%s" % (rviz.returncode, attempt, log_path.read_text()))
+        assert not crashed, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
         shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])

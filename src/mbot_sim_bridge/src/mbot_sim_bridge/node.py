@@ -41,7 +41,7 @@ class SimBridgeNode:
     def __init__(self):
         # Every ~param is read here, once (teleop_twist_keyboard style), and logged once below.
         self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
-        self.start_paused = _bool_param("~paused", False)
+        self.paused = _bool_param("~paused", False)
         requested_gui = _bool_param("~gui", False)
         headless = _bool_param("~headless", False)
         real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
@@ -63,7 +63,6 @@ class SimBridgeNode:
         self.engine.add_world(self.world)
         self.real_time_factor = (float(real_time_factor) if real_time_factor
                                  else self.physics.max_step_size * self.physics.real_time_update_rate)
-        self.paused = self.start_paused
         self.rng = numpy.random.default_rng(seed)
 
         self.clock_publisher = loop_publisher("/clock", Clock)
