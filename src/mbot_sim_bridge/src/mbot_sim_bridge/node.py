@@ -6,7 +6,9 @@ use rospy.Rate or rospy.sleep, because under use_sim_time those wait for the /cl
 """
 import os
 import queue
+import signal
 import sys
+import threading
 import time
 from concurrent.futures import Future
 from typing import Callable, Dict, List
@@ -110,9 +112,9 @@ class SimBridgeNode:
                 plugin.reset(self.engine.sim_time)
         self._restart_pacing()
 
-    def run(self):
+    def run(self, stop: threading.Event):
         self._restart_pacing()
-        while not rospy.is_shutdown():
+        while not (stop.is_set() or rospy.is_shutdown()):
             self._serve_requests(block=self.paused)
             if self.paused:
                 continue
@@ -191,14 +193,22 @@ def _workspace_worlds() -> str:
 
 
 def main():
+    # rospy's own SIGINT handler shuts the node down inside the signal, in whatever the main thread was doing;
+    # when that is a publish or a call to the master, it waits on a lock the main thread holds, for ever.
+    # Here a signal only asks the loop to stop, and the shutdown runs after it, outside any lock.
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
     verbose = "--verbose" in rospy.myargv(sys.argv)[1:]
-    rospy.init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO)
+    rospy.init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO, disable_signals=True)
     try:
         node = SimBridgeNode()
     except BridgeError as error:
         rospy.logfatal(str(error))
+        rospy.signal_shutdown("bad input")
         sys.exit(1)
     try:
-        node.run()
+        node.run(stop)
     finally:
         node.close()
+        rospy.signal_shutdown("stopped")
