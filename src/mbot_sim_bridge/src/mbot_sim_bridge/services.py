@@ -105,16 +105,20 @@ class GazeboRosApi:
             return response_type(success=False, status_message=str(error))
 
     # -- spawn and delete -------------------------------------------------------------------------------------
+    def _new_model_pose(self, request) -> Pose:
+        """The world pose a SpawnModel request asks for, once its name is known to be free."""
+        if request.model_name in self.node.engine.model_names():
+            raise ModelError("SpawnModel: Failure - entity already exists: %s" % request.model_name)
+        return compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+
     def _spawn_urdf_model(self, request):
         def spawn():
             name = request.model_name
-            if name in self.node.engine.model_names():
-                raise ModelError("SpawnModel: Failure - entity already exists: %s" % name)
+            pose = self._new_model_pose(request)
             model = parse_robot(_resolve_package_uris(request.model_xml), "model '%s'" % name)
             namespace = request.robot_namespace
             if namespace:
                 _inject_namespace(model, namespace)
-            pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
             self.spawn_robot(model, name, pose, namespace or "/")
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
@@ -123,9 +127,7 @@ class GazeboRosApi:
         """A world-like model (no plugins or joints are simulated for SDF models), placed like gazebo_ros does."""
         def spawn():
             name = request.model_name
-            if name in self.node.engine.model_names():
-                raise ModelError("SpawnModel: Failure - entity already exists: %s" % name)
-            pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+            pose = self._new_model_pose(request)
             world_xml = spawn_world_xml(_resolve_package_uris(request.model_xml), name, pose)
             # The world loader reads files (relative URIs resolve against them); a private temp file holds it.
             with tempfile.NamedTemporaryFile("w", prefix="mbot_spawn_", suffix=".world") as world_file:
@@ -157,7 +159,7 @@ class GazeboRosApi:
                 plugins.append(plugin_class(context, element))
             for link_name, sensor in model.sensors():
                 plugins.extend(self._sensor_plugins(context, link_name, sensor))
-            published = {joint for plugin in plugins for joint in getattr(plugin, "wheel_joints", ())}
+            published = {joint for plugin in plugins for joint in plugin.joint_states_published}
             remaining = [joint for joint in robot.movable_joints if joint not in published]
             if remaining:
                 plugins.append(ModelJointStatePublisher(context, remaining, self.node.joint_state_rate))

@@ -51,6 +51,8 @@ class BridgePlugin:
     timer: UpdateTimer
     # True when the plugin must see every physics step (the diff drive's encoder odometry).
     needs_every_step = False
+    # Joints whose states the plugin publishes; the bridge publishes the other movable joints itself.
+    joint_states_published = ()
 
     def on_step(self, step_size: float):
         """Called after every physics step when ``needs_every_step``."""

@@ -80,8 +80,7 @@ class GazeboRosDiffDrive(BridgePlugin):
                       params["updateRate"], self.geometry.legacy_mode)
 
     @property
-    def wheel_joints(self):
-        """The joints whose states this plugin publishes (only when publishWheelJointState)."""
+    def joint_states_published(self):
         return self.joints if self.joint_state_publisher is not None else ()
 
     def _on_command(self, message: Twist):
