@@ -147,11 +147,6 @@ class Engine:
             step()
         self.steps += count
 
-    def set_gravity(self, gravity: Sequence[float]):
-        self.physics = PhysicsConfig(self.physics.max_step_size, self.physics.real_time_factor,
-                                     self.physics.real_time_update_rate, tuple(gravity))
-        self.client.setGravity(*gravity)
-
     def add_world(self, world: LoadedWorld):
         """Register the bodies a world loader built, so reset and model queries know them."""
         for name, body in world.bodies.items():

@@ -80,12 +80,6 @@ class RobotModel:
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
 
-    def parent_joint(self, link_name: str) -> Optional[Joint]:
-        for joint in self.joints.values():
-            if joint.child == link_name:
-                return joint
-        return None
-
     def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
         """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
         return [(link.name, sensor) for link in self.links.values()
