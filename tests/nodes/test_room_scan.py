@@ -11,7 +11,7 @@ import unittest
 import numpy
 import rospy
 import rostest
-from mbot_sim_bridge.core.world import parse_world
+from mbot_sim_bridge.core.sdf_world import parse_world
 from sensor_msgs.msg import LaserScan
 
 from sim_support import Simulator, wait_for

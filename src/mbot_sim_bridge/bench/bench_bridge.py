@@ -28,7 +28,8 @@ def raw_pybullet_rtf(sim_seconds: float) -> float:
     from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
     from mbot_sim_bridge.core.engine import Engine
     from mbot_sim_bridge.core.robot_model import parse_robot
-    from mbot_sim_bridge.core.world import load_world, parse_world
+    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.world_bodies import load_world
 
     urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
                                            "mbot_gazebo.xacro")).toxml()

@@ -23,7 +23,9 @@ from .core.clock import UpdateTimer
 from .core.engine import Engine
 from .core.errors import BridgeError, WorldError
 from .core.viewer import Viewer
-from .core.world import PhysicsConfig, default_model_path, load_world, parse_world
+from .core.sdf_world import PhysicsConfig, parse_world
+from .core.world_bodies import load_world
+from .core.model_path import default_model_path
 from .plugins import BridgePlugin, TransformBroadcaster, loop_publisher
 from .services import GazeboRosApi
 

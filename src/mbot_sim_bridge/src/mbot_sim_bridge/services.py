@@ -24,7 +24,9 @@ from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .core.log import get_logger, warn_once
 from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
-from .core.world import default_model_path, load_world, parse_world
+from .core.sdf_world import parse_world
+from .core.world_bodies import load_world
+from .core.model_path import default_model_path
 from .plugins import PluginContext, loop_publisher
 from .plugins.gazebo_ros_diff_drive import GazeboRosDiffDrive
 from .plugins.gazebo_ros_laser import GazeboRosLaser

@@ -9,7 +9,8 @@ from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rpy, yaw
 from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.world import load_world, parse_world
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.world_bodies import load_world
 
 WHEELS = ("left_wheel_joint", "right_wheel_joint")
 EMPTY_WORLD = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds", "empty.world")

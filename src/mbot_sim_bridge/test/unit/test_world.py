@@ -12,8 +12,9 @@ import pytest
 from mbot_sim_bridge.core.errors import WorldError
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.mesh import load_mesh
-from mbot_sim_bridge.core.world import (PhysicsConfig, default_model_path, load_world, parse_world,
-                                        world_lateral_friction)
+from mbot_sim_bridge.core.sdf_world import PhysicsConfig, parse_world
+from mbot_sim_bridge.core.world_bodies import load_world, world_lateral_friction
+from mbot_sim_bridge.core.model_path import default_model_path
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TEST_WORLDS = os.path.join(HERE, "..", "worlds")
@@ -417,7 +418,7 @@ def test_malformed_xml_is_a_world_error_with_file_and_line(tmp_path):
     path = write(tmp_path, "play.world", world_text("    <model name='m'>\n      <link name='l'>\n    </model>"))
     with pytest.raises(WorldError) as error:
         parse_world(path)
-    assert str(error.value) == f"{path}:6: mismatched tag"
+    assert str(error.value) == f"{path}:6: not valid XML: mismatched tag"
 
 
 def test_a_file_without_a_world_is_a_world_error(tmp_path):
@@ -427,8 +428,10 @@ def test_a_file_without_a_world_is_a_world_error(tmp_path):
 
 
 @pytest.mark.parametrize("bad, message", [
-    ("<box><size>1 1</size></box>", "<size> needs 3 numbers, got '1 1'"),
-    ("<sphere><radius>-1</radius></sphere>", "<radius> must be positive, got -1"),
+    ("<box><size>1 1</size></box>", "<size>: expected 3 numbers, got '1 1'"),
+    ("<sphere><radius>-1</radius></sphere>", "<radius>: -1 is outside the valid range > 0"),
+    ("<sphere><radius>nan</radius></sphere>", "<radius>: NaN is not a valid value: 'nan'"),
+    ("<box><size>1 inf 1</size></box>", "<size>: infinity is not a valid value: '1 inf 1'"),
 ])
 def test_bad_values_are_world_errors_with_file_and_line(tmp_path, bad, message):
     path = write(tmp_path, "w.world", world_text(f"""    <model name="m">

@@ -17,7 +17,8 @@ from .errors import ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
 from .log import get_logger, warn_once
 from .robot_model import RobotModel
-from .world import LoadedWorld, PhysicsConfig
+from .sdf_world import PhysicsConfig
+from .world_bodies import LoadedWorld
 
 _logger = get_logger(__name__)
 

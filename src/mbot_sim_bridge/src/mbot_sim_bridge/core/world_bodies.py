@@ -1,0 +1,137 @@
+"""Bodies in PyBullet for an SDF world description (see ``sdf_world``).
+
+Each model becomes one PyBullet multibody: a base that carries the model's mass and every collision as a
+massless child on a fixed joint. A static model gets mass 0, which PyBullet treats as immovable. SDF
+joints are not simulated, so the links of one model move as one rigid body.
+"""
+from dataclasses import dataclass
+from typing import Dict, Optional, Tuple
+
+import numpy as np
+import pybullet
+from scipy.spatial.transform import Rotation
+
+from .geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
+from .log import get_logger, warn_once
+from .sdf_world import ModelDescription, PhysicsConfig, Shape, WorldDescription
+
+_log = get_logger(__name__)
+
+# PyBullet's createCollisionShape limits for mesh data passed as arrays.
+_BULLET_MAX_MESH_VERTICES = 131072
+_BULLET_MAX_MESH_INDICES = 524288
+
+
+@dataclass(frozen=True)
+class LoadedWorld:
+    physics: PhysicsConfig
+    bodies: Dict[str, int]  # model name -> PyBullet body id
+    shapes: Tuple[Shape, ...]  # the collisions that became PyBullet shapes
+    # model name -> the body's centre-of-mass frame in the model frame; PyBullet reports base poses in it
+    inertial_frames: Dict[str, Pose]
+
+    def model_pose(self, client, name: str) -> Pose:
+        """World pose of the model frame of ``name`` now."""
+        position, orientation = client.getBasePositionAndOrientation(self.bodies[name])
+        return compose(Pose(tuple(position), tuple(orientation)), inverse(self.inertial_frames[name]))
+
+
+def world_lateral_friction(mu: float, mu2: float) -> float:
+    """PyBullet ``lateralFriction`` for a world collision with SDF ``<ode><mu>``/``<mu2>``.
+
+    ODE takes min(μa, μb) per contact; Bullet multiplies the two bodies' frictions. With the world side at
+    min(μ, μ2, 1) the product equals ODE's value whenever the robot's μ is 1 (the SDF default) or the world's
+    is at least 1 (the ground plane's 100) and the robot's at most 1. When both are below 1 the product is
+    smaller than ODE's min. Bullet's friction is isotropic, so the smaller of μ and μ2 is used.
+    """
+    return min(mu, mu2, 1.0)
+
+
+def load_world(client, description: WorldDescription) -> LoadedWorld:
+    """Build one body per model of ``description`` in ``client`` (a BulletClient).
+
+    Gravity and time step stay with the caller (the Engine applies ``description.physics``).
+    """
+    bodies, shapes, inertial_frames = {}, [], {}
+    for model in description.models:
+        collision_shapes = [(shape, _collision_shape(client, shape, concave=model.static)) for shape in model.shapes]
+        collision_shapes = [(shape, index) for shape, index in collision_shapes if index is not None]
+        if not collision_shapes:
+            _log.debug("model '%s' has no collision shape; no body created", model.name)
+            continue
+        bodies[model.name], inertial_frames[model.name] = _create_body(client, model, collision_shapes)
+        for index, (shape, _) in enumerate(collision_shapes):
+            if shape.rgba is not None:  # only the simulator window shows it
+                client.changeVisualShape(bodies[model.name], index, rgbaColor=shape.rgba)
+        shapes.extend(shape for shape, _ in collision_shapes)
+    return LoadedWorld(description.physics, bodies, tuple(shapes), inertial_frames)
+
+
+def _collision_shape(client, shape: Shape, concave: bool) -> Optional[int]:
+    if shape.kind == "box":
+        return client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[s / 2.0 for s in shape.size])
+    if shape.kind == "cylinder":
+        return client.createCollisionShape(pybullet.GEOM_CYLINDER, radius=shape.radius, height=shape.length)
+    if shape.kind == "sphere":
+        return client.createCollisionShape(pybullet.GEOM_SPHERE, radius=shape.radius)
+    if shape.kind == "plane":
+        return client.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=shape.normal)
+    vertices, triangles = shape.mesh.vertices, shape.mesh.triangles
+    if len(vertices) > _BULLET_MAX_MESH_VERTICES or (concave and triangles.size > _BULLET_MAX_MESH_INDICES):
+        warn_once(_log, f"{shape.mesh_path}: {len(vertices)} vertices and {len(triangles)} triangles exceed "
+                        f"PyBullet's mesh limits ({_BULLET_MAX_MESH_VERTICES}, {_BULLET_MAX_MESH_INDICES // 3}); "
+                        f"collision '{shape.name}' of model '{shape.model}' skipped")
+        return None
+    if concave:  # a triangle mesh, as ODE collides it, works in Bullet only for bodies that never move
+        return client.createCollisionShape(pybullet.GEOM_MESH, vertices=vertices.tolist(),
+                                           indices=triangles.ravel().tolist())
+    return client.createCollisionShape(pybullet.GEOM_MESH, vertices=vertices.tolist())  # convex hull
+
+
+def _create_body(client, model: ModelDescription, collision_shapes) -> Tuple[int, Pose]:
+    world_to_model = inverse(model.pose)
+    child_frames = [compose(world_to_model, shape.pose) for shape, _ in collision_shapes]
+    mass, inertial_frame, moments = (0.0, IDENTITY, None) if model.static else _mass_properties(model)
+    if not model.static and mass == 0.0:
+        warn_once(_log, f"model '{model.name}' is not static but has no mass; PyBullet keeps it fixed")
+    count = len(collision_shapes)
+    body = client.createMultiBody(
+        baseMass=mass, baseCollisionShapeIndex=-1, basePosition=model.pose.position,
+        baseOrientation=model.pose.orientation, baseInertialFramePosition=inertial_frame.position,
+        baseInertialFrameOrientation=inertial_frame.orientation,
+        linkMasses=[0.0] * count, linkCollisionShapeIndices=[index for _, index in collision_shapes],
+        linkVisualShapeIndices=[-1] * count, linkPositions=[frame.position for frame in child_frames],
+        linkOrientations=[frame.orientation for frame in child_frames],
+        linkInertialFramePositions=[IDENTITY.position] * count,
+        linkInertialFrameOrientations=[IDENTITY.orientation] * count,
+        linkParentIndices=[0] * count, linkJointTypes=[pybullet.JOINT_FIXED] * count,
+        linkJointAxis=[(0.0, 0.0, 1.0)] * count)
+    if moments is not None:
+        client.changeDynamics(body, -1, localInertiaDiagonal=moments)
+    for link_index, (shape, _) in enumerate(collision_shapes):
+        client.changeDynamics(body, link_index, lateralFriction=world_lateral_friction(shape.mu, shape.mu2),
+                              restitution=0.0)
+    return body, inertial_frame
+
+
+def _mass_properties(model: ModelDescription) -> Tuple[float, Pose, Optional[Tuple[float, float, float]]]:
+    """Total mass, principal centre-of-mass frame (in the model frame) and principal moments of the welded links."""
+    world_to_model = inverse(model.pose)
+    frames = [compose(world_to_model, compose(link.pose, link.inertial_pose)) for link in model.links]
+    masses = np.array([link.mass for link in model.links])
+    total = float(masses.sum())
+    if total <= 0.0:
+        return 0.0, IDENTITY, None
+    centres = np.array([frame.position for frame in frames])
+    centre = masses @ centres / total
+    inertia = np.zeros((3, 3))
+    for link, frame, offset in zip(model.links, frames, centres - centre):
+        ixx, ixy, ixz, iyy, iyz, izz = link.inertia
+        rotation = np.array(rotation_matrix(frame.orientation))
+        local = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        # Rotate into the model frame, then move to the common centre (parallel-axis theorem).
+        inertia += rotation @ local @ rotation.T + link.mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+    moments, axes = np.linalg.eigh(inertia)
+    if np.linalg.det(axes) < 0.0:
+        axes[:, 2] = -axes[:, 2]
+    return total, Pose(tuple(centre), tuple(Rotation.from_matrix(axes).as_quat())), tuple(float(m) for m in moments)
