@@ -11,78 +11,77 @@ import sys
 import threading
 import time
 from concurrent.futures import Future
-from typing import Callable, Dict, List
+from typing import Callable
 
-import numpy
 import pybullet
 import rospkg
 import rospy
 from rosgraph_msgs.msg import Clock
 
 from .core.clock import UpdateTimer
-from .core.engine import Engine
 from .core.errors import BridgeError, WorldError
-from .core.viewer import Viewer
-from .core.sdf_world import PhysicsConfig, parse_world
-from .core.world_bodies import load_world
 from .core.model_path import default_model_path
-from .plugins import BridgePlugin, TransformBroadcaster, loop_publisher
+from .core.sdf_world import parse_world
+from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
+from .core.xml_values import parse_bool
+from .plugins import loop_publisher, ros_time
+from .plugins.registry import REGISTRY
 from .services import GazeboRosApi
 
 DEFAULT_CLOCK_FREQUENCY = 100.0
-# Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
-_MAX_BATCH_SIM_SECONDS = 0.01
 # How far ahead of the wall clock the loop may run before it sleeps, at a real-time factor > 0.
 _PACING_SLACK_SECONDS = 0.002
 
 
 def _bool_param(name: str, default: bool) -> bool:
     value = rospy.get_param(name, default)
-    return value if isinstance(value, bool) else str(value).strip().lower() in ("true", "1")
+    if isinstance(value, bool):
+        return value
+    try:
+        return parse_bool(str(value))
+    except ValueError as error:
+        raise BridgeError("parameter %s: %s, got '%s'" % (rospy.resolve_name(name), error, value)) from None
 
 
 class SimBridgeNode:
     def __init__(self):
         # Every ~param is read here, once (teleop_twist_keyboard style), and logged once below.
         self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
-        self.paused = _bool_param("~paused", False)
+        paused = _bool_param("~paused", False)
         requested_gui = _bool_param("~gui", False)
         headless = _bool_param("~headless", False)
         real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
         # Gazebo publishes /clock on every step; from Python that costs more than the step itself, so the
         # bridge defaults to 100 Hz and also publishes right before any plugin output (see README).
         clock_frequency = float(rospy.get_param("~pub_clock_frequency", DEFAULT_CLOCK_FREQUENCY))
-        self.joint_state_rate = float(rospy.get_param("~joint_state_rate", 100.0))
+        joint_state_rate = float(rospy.get_param("~joint_state_rate", 100.0))
         seed = int(rospy.get_param("~seed", 0))
 
         world = parse_world(self.world_path, default_model_path())
-        self.physics: PhysicsConfig = world.physics
-        self.gui = requested_gui and not headless and bool(os.environ.get("DISPLAY"))
-        if requested_gui and not self.gui:
+        gui = requested_gui and not headless and bool(os.environ.get("DISPLAY"))
+        if requested_gui and not gui:
             rospy.loginfo("gui:=true, but %s: running without a window"
                           % ("headless:=true" if headless else "no DISPLAY is set"))
-        self.engine = Engine(self.physics, pybullet.GUI if self.gui else pybullet.DIRECT)
-        self.viewer = Viewer(self.engine) if self.gui else None
-        self.world = load_world(self.engine.client, world)
-        self.engine.add_world(self.world)
+        self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate)
+        self.sim.paused = paused
+        physics = world.physics
+        self.step_size = physics.max_step_size
         self.real_time_factor = (float(real_time_factor) if real_time_factor
-                                 else self.physics.max_step_size * self.physics.real_time_update_rate)
-        self.rng = numpy.random.default_rng(seed)
+                                 else physics.max_step_size * physics.real_time_update_rate)
 
         self.clock_publisher = loop_publisher("/clock", Clock)
         self.clock_timer = UpdateTimer(clock_frequency)
-        self.tf_broadcaster = TransformBroadcaster()
-        self.plugins: Dict[str, List[BridgePlugin]] = {}
+        self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
         self._requests: "queue.Queue[tuple]" = queue.Queue()
         self._pace_wall_start = self._pace_sim_start = 0.0
         # gazebo_ros sets /use_sim_time only when nobody has.
         if not rospy.has_param("/use_sim_time"):
             rospy.set_param("/use_sim_time", True)
         rospy.loginfo("world %s: step %.4f s, gravity %s, real-time factor %s, /clock %s, %s, %s",
-                      self.world_path, self.physics.max_step_size, self.physics.gravity,
+                      self.world_path, physics.max_step_size, physics.gravity,
                       self.real_time_factor or "0 (as fast as possible)",
                       "every step" if clock_frequency <= 0 else "at %.0f Hz" % clock_frequency,
-                      "paused" if self.paused else "running", "GUI" if self.gui else "headless")
+                      "paused" if paused else "running", "GUI" if gui else "headless")
         # Last: its services take calls at once, from other threads, and those use everything above.
         self.api = GazeboRosApi(self)
 
@@ -94,61 +93,34 @@ class SimBridgeNode:
         return future.result(timeout)
 
     # -- loop thread --------------------------------------------------------------------------------------
-    def stamp(self) -> rospy.Time:
-        nanoseconds = int(round(self.engine.sim_time * 1e9))
-        return rospy.Time(*divmod(nanoseconds, 1000000000))
-
     def set_paused(self, paused: bool):
-        self.paused = paused
+        self.sim.paused = paused
         self._restart_pacing()
 
     def reset(self, simulation: bool):
         """reset_simulation (sim time back to 0) or reset_world (models only); plugins are reset either way."""
+        self.sim.reset(simulation)
         if simulation:
-            self.engine.reset_simulation()
             self.clock_timer.reset(0.0)
-        else:
-            self.engine.reset_world()
-        for plugins in self.plugins.values():
-            for plugin in plugins:
-                plugin.reset(self.engine.sim_time)
         self._restart_pacing()
 
     def run(self, stop: threading.Event):
         self._restart_pacing()
         while not (stop.is_set() or rospy.is_shutdown()):
-            self._serve_requests(block=self.paused)
-            if self.paused:
+            self._serve_requests(block=self.sim.paused)
+            if self.sim.paused:
                 continue
-            every_step = [plugin for plugins in self.plugins.values() for plugin in plugins
-                          if plugin.needs_every_step]
-            count = 1 if every_step else self._steps_to_next_event()
-            self.engine.step(count)
-            for plugin in every_step:
-                plugin.on_step(self.physics.max_step_size)
-            self._run_due_updates()
-            if self.viewer is not None:
-                self.viewer.follow()
+            until_clock = self.clock_timer.steps_until_due(self.sim.sim_time, self.step_size)
+            self.sim.advance(min(until_clock, self._batch_steps), self._before_updates)
             self._pace()
 
-    def _steps_to_next_event(self) -> int:
-        now, step = self.engine.sim_time, self.physics.max_step_size
-        candidates = [self.clock_timer.steps_until_due(now, step)]
-        candidates.extend(plugin.timer.steps_until_due(now, step)
-                          for plugins in self.plugins.values() for plugin in plugins)
-        return max(1, min(min(candidates), int(round(_MAX_BATCH_SIM_SECONDS / step))))
-
-    def _run_due_updates(self):
-        now = self.engine.sim_time
-        due = [plugin for plugins in list(self.plugins.values()) for plugin in plugins if plugin.timer.due(now)]
+    def _before_updates(self, now: float, plugins_due: bool):
         # /clock goes first, so no message is stamped ahead of the clock its subscribers have seen.
-        if self.clock_timer.due(now) or due:
-            self.clock_publisher.publish(Clock(clock=self.stamp()))
+        if self.clock_timer.due(now) or plugins_due:
+            self.clock_publisher.publish(Clock(clock=ros_time(now)))
             self.api.publish_model_states()
             # The timer guarantees the longest gap between two /clock messages, counted from the last one.
             self.clock_timer.reset(now)
-        for plugin in due:
-            plugin.update(now)
 
     def _serve_requests(self, block: bool):
         try:
@@ -168,21 +140,18 @@ class SimBridgeNode:
 
     def _restart_pacing(self):
         self._pace_wall_start = time.monotonic()
-        self._pace_sim_start = self.engine.sim_time
+        self._pace_sim_start = self.sim.sim_time
 
     def _pace(self):
         if self.real_time_factor <= 0:
             return
-        target = self._pace_wall_start + (self.engine.sim_time - self._pace_sim_start) / self.real_time_factor
+        target = self._pace_wall_start + (self.sim.sim_time - self._pace_sim_start) / self.real_time_factor
         ahead = target - time.monotonic()
         if ahead > _PACING_SLACK_SECONDS:
             time.sleep(ahead)
 
     def close(self):
-        for name in list(self.plugins):
-            for plugin in self.plugins.pop(name):
-                plugin.close()
-        self.engine.close()
+        self.sim.close()
 
 
 def _workspace_worlds() -> str:

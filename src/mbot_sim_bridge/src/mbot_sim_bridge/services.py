@@ -1,11 +1,10 @@
 """gazebo_ros's ROS API (``libgazebo_ros_api_plugin.so``): the /gazebo/* services and model_states.
 
-Handlers run in rospy's threads and hand the work to the loop thread through ``node.call_in_loop``.
-Spawning a robot also builds its plugins from the robot's own ``<gazebo>`` blocks.
+Handlers run in rospy's threads; each converts the request into Simulation calls that run in the loop
+thread (``node.call_in_loop``) and the result back into a response.
 """
 import re
 import tempfile
-from typing import List
 from xml.etree import ElementTree
 
 import rospkg
@@ -21,22 +20,12 @@ from std_srvs.srv import Empty, EmptyResponse
 
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
-from .core.log import get_logger, warn_once
+from .core.model_path import default_model_path
 from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
 from .core.sdf_world import parse_world
-from .core.world_bodies import load_world
-from .core.model_path import default_model_path
-from .plugins import PluginContext, loop_publisher
-from .plugins.gazebo_ros_diff_drive import GazeboRosDiffDrive
-from .plugins.gazebo_ros_laser import GazeboRosLaser
-from .plugins.model_joint_states import ModelJointStatePublisher
+from .plugins import loop_publisher, ros_time
 
-_logger = get_logger(__name__)
-
-# Gazebo plugin file name -> the class that emulates it (one module per .so, named after it).
-MODEL_PLUGINS = {"libgazebo_ros_diff_drive.so": GazeboRosDiffDrive}
-SENSOR_PLUGINS = {"libgazebo_ros_laser.so": GazeboRosLaser, "libgazebo_ros_gpu_laser.so": GazeboRosLaser}
 _WORLD_FRAMES = ("", "world", "map", "/map")
 
 
@@ -77,6 +66,7 @@ def _resolve_package_uris(xml: str) -> str:
 class GazeboRosApi:
     def __init__(self, node):
         self.node = node
+        self.sim = node.sim
         self.model_states_publisher = loop_publisher("~model_states", ModelStates)
         self._services = [
             rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
@@ -109,7 +99,7 @@ class GazeboRosApi:
     # -- spawn and delete -------------------------------------------------------------------------------------
     def _new_model_pose(self, request) -> Pose:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
-        if request.model_name in self.node.engine.model_names():
+        if request.model_name in self.sim.model_names():
             raise ModelError("SpawnModel: Failure - entity already exists: %s" % request.model_name)
         return compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
 
@@ -121,7 +111,7 @@ class GazeboRosApi:
             namespace = request.robot_namespace
             if namespace:
                 _inject_namespace(model, namespace)
-            self.spawn_robot(model, name, pose, namespace or "/")
+            self.sim.spawn_robot(model, name, pose, namespace or "/")
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
 
@@ -136,69 +126,15 @@ class GazeboRosApi:
                 world_file.write(world_xml)
                 world_file.flush()
                 description = parse_world(world_file.name, default_model_path())
-            self.node.engine.add_world(load_world(self.node.engine.client, description))
-            if name not in self.node.engine.model_names():
+            if name not in self.sim.add_world(description):
                 raise ModelError("model '%s' has no collision geometry; nothing to simulate" % name)
             rospy.loginfo("spawned SDF model '%s' at %s", name, tuple(round(v, 3) for v in pose.position))
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
 
-    def spawn_robot(self, model, name, pose, namespace):
-        """Put a parsed robot in the engine with its plugins; on a plugin error, leave nothing behind."""
-        engine = self.node.engine
-        driven = [element.findtext(tag, "").strip() for element in model.plugins
-                  if element.get("filename") == "libgazebo_ros_diff_drive.so" for tag in ("leftJoint", "rightJoint")]
-        robot = engine.spawn_robot(model, name, pose, namespace, driven_joints=driven)
-        context = PluginContext(engine, robot, self.node.tf_broadcaster, self.node.stamp)
-        plugins = []
-        try:
-            for element in model.plugins:
-                plugin_class = MODEL_PLUGINS.get(element.get("filename"))
-                if plugin_class is None:
-                    warn_once(_logger, "model '%s': plugin '%s' (%s) is not emulated by the bridge; ignored"
-                              % (name, element.get("name"), element.get("filename")))
-                    continue
-                plugins.append(plugin_class(context, element))
-            for link_name, sensor in model.sensors():
-                plugins.extend(self._sensor_plugins(context, link_name, sensor))
-            published = {joint for plugin in plugins for joint in plugin.joint_states_published}
-            remaining = [joint for joint in robot.movable_joints if joint not in published]
-            if remaining:
-                plugins.append(ModelJointStatePublisher(context, remaining, self.node.joint_state_rate))
-        except BridgeError:
-            for plugin in plugins:
-                plugin.close()
-            engine.remove(name)
-            raise
-        self.node.plugins[name] = plugins
-        if self.node.viewer is not None:
-            self.node.viewer.show_robot(robot)
-        rospy.loginfo("spawned '%s' (%d links, %d movable joints, %d plugins) at %s", name, len(robot.link_index),
-                      len(robot.movable_joints), len(plugins), tuple(round(v, 3) for v in pose.position))
-        return robot
-
-    def _sensor_plugins(self, context, link_name, sensor: ElementTree.Element) -> List:
-        plugins = []
-        if not sensor.findall("plugin"):
-            warn_once(_logger, "model '%s': sensor '%s' on link '%s' has no ROS plugin; nothing is published for it"
-                      % (context.robot.name, sensor.get("name"), link_name))
-        for element in sensor.findall("plugin"):
-            plugin_class = SENSOR_PLUGINS.get(element.get("filename"))
-            if plugin_class is None:
-                warn_once(_logger, "model '%s': sensor '%s' (type %s) on link '%s': plugin %s is not emulated; "
-                          "the sensor is ignored" % (context.robot.name, sensor.get("name"), sensor.get("type"),
-                                                     link_name, element.get("filename")))
-                continue
-            plugins.append(plugin_class(context, link_name, sensor, element, self.node.rng))
-        return plugins
-
     def _delete_model(self, request):
         def delete():
-            for plugin in self.node.plugins.pop(request.model_name, []):
-                plugin.close()
-            if self.node.viewer is not None and request.model_name in self.node.engine.robots:
-                self.node.viewer.forget_robot(self.node.engine.robots[request.model_name])
-            self.node.engine.remove(request.model_name)
+            self.sim.delete(request.model_name)
             return DeleteModelResponse(success=True, status_message="DeleteModel: successfully deleted model")
         return self._guarded(DeleteModelResponse, delete)
 
@@ -206,20 +142,20 @@ class GazeboRosApi:
     def _reference_pose(self, frame: str) -> Pose:
         if frame in _WORLD_FRAMES:
             return IDENTITY
-        if frame in self.node.engine.model_names():
-            return self.node.engine.model_pose(frame)
+        if frame in self.sim.model_names():
+            return self.sim.engine.model_pose(frame)
         raise ModelError("reference frame '%s' is neither the world nor a model" % frame)
 
     def _get_model_state(self, request):
         def get():
-            engine = self.node.engine
+            engine = self.sim.engine
             reference = inverse(self._reference_pose(request.relative_entity_name))
             pose = compose(reference, engine.model_pose(request.model_name))
             linear, angular = engine.model_velocity(request.model_name)
             linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
             response = GetModelStateResponse(pose=_pose_to_message(pose), twist=_twist_message(linear, angular),
                                              success=True, status_message="GetModelState: got properties")
-            response.header.stamp = self.node.stamp()
+            response.header.stamp = ros_time(self.sim.sim_time)
             response.header.frame_id = request.relative_entity_name
             return response
         return self._guarded(GetModelStateResponse, get)
@@ -233,21 +169,20 @@ class GazeboRosApi:
             twist = state.twist
             linear = rotate(reference.orientation, (twist.linear.x, twist.linear.y, twist.linear.z))
             angular = rotate(reference.orientation, (twist.angular.x, twist.angular.y, twist.angular.z))
-            self.node.engine.set_model_state(state.model_name, pose, linear, angular)
+            self.sim.engine.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
 
     def _get_world_properties(self, _request):
         def get():
-            return GetWorldPropertiesResponse(sim_time=self.node.engine.sim_time,
-                                              model_names=self.node.engine.model_names(),
+            return GetWorldPropertiesResponse(sim_time=self.sim.sim_time, model_names=self.sim.model_names(),
                                               rendering_enabled=True, success=True, status_message="")
         return self._guarded(GetWorldPropertiesResponse, get)
 
     def _get_physics_properties(self, _request):
         def get():
-            physics = self.node.engine.physics
-            response = GetPhysicsPropertiesResponse(time_step=physics.max_step_size, pause=self.node.paused,
+            physics = self.sim.engine.physics
+            response = GetPhysicsPropertiesResponse(time_step=physics.max_step_size, pause=self.sim.paused,
                                                     max_update_rate=physics.real_time_update_rate,
                                                     success=True, status_message="")
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
@@ -258,7 +193,7 @@ class GazeboRosApi:
         """Model-frame world poses and world twists, only while someone listens (as gazebo_ros)."""
         if self.model_states_publisher.get_num_connections() == 0:
             return
-        engine = self.node.engine
+        engine = self.sim.engine
         message = ModelStates()
         for name in engine.model_names():
             message.name.append(name)

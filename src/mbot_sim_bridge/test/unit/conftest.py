@@ -17,3 +17,9 @@ def expand_xacro(relative_path: str) -> str:
 def mbot_urdf() -> str:
     """The course's Gazebo mbot (mbot_gazebo.xacro), unchanged."""
     return expand_xacro("urdf/gazebo/mbot_gazebo.xacro")
+
+
+@pytest.fixture(scope="session")
+def laser_mbot_urdf() -> str:
+    """The course's mbot with its rplidar (mbot_with_laser_gazebo.xacro)."""
+    return expand_xacro("urdf/gazebo/mbot_with_laser_gazebo.xacro")

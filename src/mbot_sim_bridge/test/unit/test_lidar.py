@@ -1,7 +1,6 @@
 """core/lidar.py: <sensor> parsing and Gazebo-style scans of tiny PyBullet worlds (DIRECT, no master)."""
 import logging
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import replace
 
 import numpy as np
@@ -9,9 +8,10 @@ import pybullet
 import pytest
 from pybullet_utils.bullet_client import BulletClient
 
-from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.errors import ConfigError, ModelError
 from mbot_sim_bridge.core.geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
 from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig, parse_ray_sensor
+from mbot_sim_bridge.core.xml_values import parse_xml
 
 # The tutorial's rplidar block, as lidar_gazebo.xacro expands it.
 RPLIDAR = """
@@ -47,14 +47,15 @@ RPLIDAR = """
   </sensor>
 </gazebo>
 """
-WHERE = "test: lidar 'rplidar' on link 'laser_link'"
+SENSOR = "lidar 'rplidar' on link 'laser_link'"
 MM = 0.005
 OWN_ROBOT_BIT = 1 << 8
 OTHER_ROBOT_BIT = 1 << 9
 
 
 def parse(xml: str = RPLIDAR) -> RaySensorConfig:
-    return parse_ray_sensor(ET.fromstring(xml).find("sensor"), "laser_link", "test")
+    document = parse_xml(xml.encode(), "test", ModelError)
+    return parse_ray_sensor(document.root.find("sensor"), "laser_link", document)
 
 
 def edited(old: str, new: str) -> str:
@@ -111,9 +112,6 @@ def test_parses_the_tutorial_rplidar():
     assert (config.vertical_samples, config.vertical_min_angle, config.vertical_max_angle) == (1, 0.0, 0.0)
     assert (config.range_min, config.range_max, config.range_resolution) == (0.10, 6.0, 0.01)
     assert (config.noise_mean, config.noise_stddev) == (0.0, 0.01)
-    assert config.plugin_filename == "libgazebo_ros_laser.so"
-    assert (config.topic_name, config.frame_name, config.robot_namespace) == ("/scan", "laser_link", None)
-    assert not config.is_gpu
     assert config.range_count == 360
     assert config.angle_increment == pytest.approx(6.0 / 359)
 
@@ -135,81 +133,41 @@ def test_sensor_pose_and_vertical_scan():
     assert (config.vertical_min_angle, config.vertical_max_angle) == (-0.2, 0.1)
 
 
-def test_plugin_defaults_are_gazebos_and_missing_tags_warn(caplog):
-    config = parse(edited("<topicName>/scan</topicName>\n      <frameName>laser_link</frameName>", ""))
-    assert (config.topic_name, config.frame_name) == ("/world", "world")
-    assert f"{WHERE}: libgazebo_ros_laser.so: missing <topicName>, default is /world" in caplog.text
-    assert f"{WHERE}: libgazebo_ros_laser.so: missing <frameName>, default is /world" in caplog.text
-
-
-def test_frame_name_loses_one_leading_slash_and_namespace_is_kept():
-    config = parse(edited("<frameName>laser_link</frameName>",
-                          "<frameName>/laser_link</frameName><robotNamespace></robotNamespace>"))
-    assert (config.frame_name, config.robot_namespace) == ("laser_link", "")
-
-
-def test_sensor_without_plugin_has_nothing_to_publish():
-    config = parse(RPLIDAR[:RPLIDAR.index("<plugin")] + "</sensor></gazebo>")
-    assert config.plugin_filename is None
-
-
-def test_gpu_ray_with_gpu_plugin():
-    config = parse(edited('type="ray"', 'type="gpu_ray"').replace("libgazebo_ros_laser.so",
-                                                                  "libgazebo_ros_gpu_laser.so"))
-    assert config.is_gpu
-    assert config.plugin_filename == "libgazebo_ros_gpu_laser.so"
-
-
 @pytest.mark.parametrize("old, new, message", [
-    ("<samples>360</samples>", "<samples>abc</samples>", "<samples> must be a positive integer, got 'abc'"),
-    ("<samples>360</samples>", "<samples>0</samples>", "<samples> must be a positive integer, got '0'"),
+    ("<samples>360</samples>", "<samples>abc</samples>",
+     "<ray/scan/horizontal/samples> has bad value 'abc': expected a whole number, got 'abc'"),
+    ("<samples>360</samples>", "<samples>0</samples>",
+     "<ray/scan/horizontal/samples> has bad value '0': 0 is outside the valid range >= 1"),
     ("<resolution>1</resolution>", "<resolution>-1</resolution>",
-     "<resolution> must be a positive number, got '-1'"),
+     "<ray/scan/horizontal/resolution> has bad value '-1': -1 is outside the valid range > 0"),
     ("<min_angle>-3</min_angle>", "<min_angle>nan</min_angle>",
-     "<min_angle> must be a finite number, got 'nan'"),
+     "<ray/scan/horizontal/min_angle> has bad value 'nan': NaN is not a valid value"),
     ("<min_angle>-3</min_angle>", "<min_angle>4</min_angle>",
      "<min_angle> (4.0) must not exceed <max_angle> (3.0)"),
     ("<max>6.0</max>", "<max>0.05</max>", "<range><max> (0.05) must exceed <range><min> (0.1)"),
     ("<stddev>0.01</stddev>", "<stddev>-0.01</stddev>",
-     "<noise><stddev> must be a non-negative number, got '-0.01'"),
+     "<ray/noise/stddev> has bad value '-0.01': -0.01 is outside the valid range >= 0"),
     ("<update_rate>5.5</update_rate>", "<update_rate>fast</update_rate>",
-     "<update_rate> must be a non-negative number, got 'fast'"),
+     "<update_rate> has bad value 'fast': expected a number, got 'fast'"),
     ("<pose>0 0 0 0 0 0</pose>", "<pose>0 0 0</pose>",
-     "<pose> must be six numbers 'x y z roll pitch yaw', got '0 0 0'"),
-    ("<min>0.10</min>", "", "missing <range><min>"),
-    ("horizontal>", "horizontl>", "missing <scan><horizontal>"),
+     "<pose> (x y z roll pitch yaw): expected 6 numbers, got '0 0 0'"),
+    ("<pose>0 0 0 0 0 0</pose>", "<pose>nan 0 0 0 0 0</pose>",
+     "<pose> (x y z roll pitch yaw): NaN is not a valid value: 'nan 0 0 0 0 0'"),
+    ("<min>0.10</min>", "", "missing required tag <ray/range/min>"),
+    ("horizontal>", "horizontl>", "missing required tag <ray/scan/horizontal/samples>"),
     ("<samples>360</samples>", "<samples>1</samples><resolution>0.5</resolution>", "leaves no ranges"),
     ('type="ray"', 'type="camera"', "type 'camera' is not a ray sensor"),
-    ('type="ray"', 'type="gpu_ray"',
-     'libgazebo_ros_laser.so needs <sensor type="ray">, but the sensor\'s type is "gpu_ray"'),
-    ("<topicName>/scan</topicName>", "<topicName> </topicName>", "<topicName> must not be empty"),
 ])
-def test_bad_values_name_tag_value_and_sensor(old, new, message):
+def test_bad_values_name_where_sensor_tag_value_and_range(old, new, message):
     with pytest.raises(ConfigError) as error:
         parse(edited(old, new))
-    assert str(error.value).startswith(WHERE + ": ")
+    assert str(error.value).startswith("test:") and SENSOR in str(error.value)
     assert message in str(error.value)
 
 
 def test_unnamed_sensor_is_an_error():
     with pytest.raises(ConfigError, match="a <sensor> on link 'laser_link' has no name"):
         parse(edited(' name="rplidar"', ""))
-
-
-def test_unknown_plugin_tags_warn_once(caplog):
-    xml = edited("<topicName>", "<gaussianNoise>0.01</gaussianNoise><topicName>")
-    with caplog.at_level(logging.WARNING):
-        parse(xml)
-        parse(xml)
-    warnings = [r.getMessage() for r in caplog.records if "<gaussianNoise>" in r.getMessage()]
-    assert warnings == [f"{WHERE}: libgazebo_ros_laser.so: unknown tag <gaussianNoise> ignored; "
-                        f"known tags: frameName, robotNamespace, topicName"]
-
-
-def test_other_plugins_are_ignored_with_a_warning(caplog):
-    config = parse(edited("libgazebo_ros_laser.so", "libgazebo_ros_block_laser.so"))
-    assert config.plugin_filename is None
-    assert "plugin 'libgazebo_ros_block_laser.so' is not emulated" in caplog.text
 
 
 def test_non_gaussian_noise_warns_once_and_is_off(caplog):

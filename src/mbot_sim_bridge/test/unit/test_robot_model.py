@@ -69,20 +69,32 @@ def test_sensor_blocks_are_collected_per_link():
     assert [(name, sensor.get("name")) for name, sensor in parse_robot(urdf).sensors()] == [("chassis", "scanner")]
 
 
+def test_tags_without_effect_warn_once_naming_tag_and_model(caplog):
+    urdf = robot(link("chassis"), '<gazebo reference="chassis"><kp>1e6</kp><turnGravityOff>true</turnGravityOff>'
+                 '<selfCollide>false</selfCollide></gazebo>')
+    with caplog.at_level(logging.WARNING):
+        parse_robot(urdf, "model 'probe'")
+        parse_robot(urdf, "model 'probe'")
+    messages = [r.getMessage() for r in caplog.records]
+    assert messages == ["model 'probe': <gazebo reference='chassis'> <kp> has no Bullet counterpart; ignored",
+                        "model 'probe': <gazebo reference='chassis'> <turnGravityOff>true</turnGravityOff> is not "
+                        "simulated; Gazebo's default applies"]
+
+
 def test_unknown_gazebo_tags_warn_once_and_name_the_tag(caplog):
     urdf = robot(link("chassis"), '<gazebo reference="chassis"><sparkle>yes</sparkle></gazebo>',
                  '<gazebo><teleporter/></gazebo>', '<gazebo reference="nowhere"><mu1>1</mu1></gazebo>')
     with caplog.at_level(logging.WARNING):
         parse_robot(urdf)
     text = "\n".join(r.getMessage() for r in caplog.records)
-    assert "<gazebo reference='chassis'> tag <sparkle> is not supported" in text
+    assert "<gazebo reference='chassis'> <sparkle> is not supported" in text
     assert "model-level <gazebo> tag <teleporter> is not supported" in text
     assert "<gazebo reference='nowhere'> names no link or joint" in text
 
 
 @pytest.mark.parametrize("xml, message", [
     ("", "robot_description is empty"),
-    ("<robot name='a'><link name='x'>", "robot_description is not valid XML"),
+    ("<robot name='a'><link name='x'>", "robot_description:1: not valid XML"),
     ("<sdf version='1.6'/>", "its root element is <sdf>, not <robot>"),
     ("<robot name='a'/>", "the robot has no <link>"),
     (robot(link("a"), joint("j", "continuous", "a", "b")), "joint 'j': child link 'b' is not defined"),

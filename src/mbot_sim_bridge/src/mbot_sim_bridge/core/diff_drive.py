@@ -1,14 +1,23 @@
-"""Differential-drive maths of ``libgazebo_ros_diff_drive.so``, free of ROS.
+"""``libgazebo_ros_diff_drive.so`` without ROS: the tags, the wheel motors and the odometry.
 
 Mirrors gazebo_plugins' GazeboRosDiffDrive: the command -> wheel-speed split (with Kinetic's legacyMode),
-the wheelAcceleration ramp, and the encoder odometry integration. The ROS plugin feeds it measured wheel
-speeds and sim time and applies what it returns.
+the wheelAcceleration ramp, and the encoder odometry integration. ``DiffDrive`` drives the robot's wheel
+joints from the last command; the ROS plugin feeds it cmd_vel and publishes what ``odometry()`` returns.
 """
+import logging
 import math
+import threading
 from dataclasses import dataclass
 from typing import Tuple
 
-from .params import Param
+from .clock import UpdateTimer
+from .errors import ConfigError
+from .geometry import Pose, yaw
+from .params import Param, non_negative
+from .plugin import Plugin
+
+# Below a millimetre a wheel or a track width is a typo (0, 1e-300) that makes the wheel speeds explode.
+MINIMUM_WHEEL_SIZE = 0.001
 
 DIFF_DRIVE_PARAMS = (
     Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist subscribed, relative to robotNamespace"),
@@ -19,10 +28,10 @@ DIFF_DRIVE_PARAMS = (
     Param("publishOdomTF", bool, True, "gates only the odom -> base TF", warn_if_missing=False),
     Param("publishWheelTF", bool, False, "wheel frames on /tf (through robot_state_publisher, see README)"),
     Param("publishWheelJointState", bool, False, "wheel joints on joint_states"),
-    Param("wheelSeparation", float, 0.34, "distance between the wheels (m)"),
-    Param("wheelDiameter", float, 0.15, "wheel diameter (m)"),
-    Param("wheelTorque", float, 5.0, "maximum torque of each wheel motor (N·m)"),
-    Param("wheelAcceleration", float, 0.0, "rim acceleration limit (m/s²); 0 = none"),
+    Param("wheelSeparation", float, 0.34, "distance between the wheels (m)", minimum=MINIMUM_WHEEL_SIZE),
+    Param("wheelDiameter", float, 0.15, "wheel diameter (m)", minimum=MINIMUM_WHEEL_SIZE),
+    non_negative("wheelTorque", float, 5.0, "maximum torque of each wheel motor (N·m)"),
+    non_negative("wheelAcceleration", float, 0.0, "rim acceleration limit (m/s²); 0 = none"),
     Param("updateRate", float, 100.0, "odometry and command rate (Hz, sim time); ≤ 0 = every physics step"),
     Param("odometrySource", str, "world", "world: ground truth; encoder: integrated wheel odometry",
           choices=("world", "encoder")),
@@ -34,7 +43,7 @@ DIFF_DRIVE_PARAMS = (
     Param("rosDebugLevel", str, "na", "Debug/Info/Warn/Error/Fatal: the bridge's log level",
           warn_if_missing=False),
 )
-# Read by Gazebo's Noetic plugin without effect; the bridge accepts them quietly too.
+# Read by Gazebo's Noetic plugin without effect; the bridge accepts them with one INFO line.
 DIFF_DRIVE_IGNORED_TAGS = ("alwaysOn", "broadcastTF", "torque")
 
 # Gazebo applies both targets at once when either wheel is this close to its target (m/s).
@@ -121,3 +130,90 @@ ODOM_POSE_COVARIANCE = (1e-5, 0, 0, 0, 0, 0,
                         0, 0, 0, 1e12, 0, 0,
                         0, 0, 0, 0, 1e12, 0,
                         0, 0, 0, 0, 0, 1e-3)
+
+
+_LOG_LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WARNING, "error": logging.ERROR,
+               "fatal": logging.CRITICAL}
+
+
+class DiffDrive(Plugin):
+    """The plugin's physics: wheel motors from the last command, every ``updateRate``; odometry on demand."""
+
+    GAZEBO_CLASS = "GazeboRosDiffDrive"
+    PARAMS = DIFF_DRIVE_PARAMS
+    IGNORED_TAGS = DIFF_DRIVE_IGNORED_TAGS
+
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        robot = context.robot
+        self.params = params = self.read_params()
+        # The namespace falls back to the model name, as in gazebo_ros (spawn_model always sets it).
+        self.namespace = params["robotNamespace"] or context.model.name
+        for tag in ("leftJoint", "rightJoint"):
+            if params[tag] not in robot.joint_index:
+                raise ConfigError("%s: %s: <%s> names joint '%s', which the robot does not have; movable joints: %s"
+                                  % (context.where(element), self.label, tag, params[tag],
+                                     ", ".join(robot.movable_joints) or "none"))
+        level = _LOG_LEVELS.get(params["rosDebugLevel"].lower())
+        if level is not None:
+            # Gazebo sets the whole server's roscpp level from this tag; the bridge sets its own loggers'
+            # level, leaving rospy's internals (which log broken pipes at DEBUG) at their default.
+            logging.getLogger("rosout.mbot_sim_bridge").setLevel(level)
+        self.joints = (params["leftJoint"], params["rightJoint"])
+        self.driven_joints = self.joints
+        if params["publishWheelJointState"]:
+            self.joint_states_published = self.joints
+        self.geometry = DiffDriveGeometry(params["wheelSeparation"], params["wheelDiameter"] / 2.0,
+                                          params["legacyMode"])
+        self.torque = params["wheelTorque"]
+        self.ramp = WheelSpeedRamp(params["wheelAcceleration"])
+        self.encoder = EncoderOdometry(self.geometry) if params["odometrySource"] == "encoder" else None
+        self.needs_every_step = self.encoder is not None
+        self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
+        self.last_update = context.simulation.sim_time
+        self._lock = threading.Lock()  # commands arrive from other threads
+        self._command = (0.0, 0.0)
+
+    def set_command(self, linear: float, angular: float) -> bool:
+        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return False
+        with self._lock:
+            self._command = (linear, angular)
+        return True
+
+    def on_step(self, step_size: float):
+        (_, left_rate, _), (_, right_rate, _) = self.context.robot.joint_state(self.joints)
+        self.encoder.integrate(left_rate, right_rate, step_size)
+
+    def update(self, now: float):
+        with self._lock:
+            linear, angular = self._command
+        robot = self.context.robot
+        targets = self.geometry.wheel_rim_speeds(linear, angular)
+        radius = self.geometry.wheel_radius
+        measured = tuple(rate * radius for _, rate, _ in robot.joint_state(self.joints))
+        speeds = self.ramp.step(targets, measured, now - self.last_update)
+        for joint, speed in zip(self.joints, speeds):
+            robot.set_joint_velocity(joint, speed / radius, self.torque)
+        self.last_update = now
+
+    def odometry(self) -> Tuple[Pose, Tuple[float, float], float]:
+        """(pose, body-frame (vx, vy), ωz) as the plugin's odometry reports them for its odometrySource."""
+        if self.encoder is None:
+            robot = self.context.robot
+            root = robot.root_pose()
+            linear, angular = robot.root_velocity()
+            return root, yaw_rotated_velocity(linear, yaw(root.orientation)), angular[2]
+        encoder = self.encoder
+        pose = Pose((encoder.x, encoder.y, 0.0), (0.0, 0.0, math.sin(encoder.theta / 2), math.cos(encoder.theta / 2)))
+        return pose, (encoder.linear, 0.0), encoder.angular
+
+    def reset(self, now: float):
+        super().reset(now)
+        self.last_update = now
+        self.ramp.reset()
+        if self.encoder is not None:
+            self.encoder.reset()
+        with self._lock:
+            self._command = (0.0, 0.0)

@@ -8,7 +8,7 @@ import os
 import sys
 import tempfile
 from dataclasses import dataclass
-from typing import Dict, List, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
@@ -19,6 +19,7 @@ from .log import get_logger, warn_once
 from .robot_model import RobotModel
 from .sdf_world import PhysicsConfig
 from .world_bodies import LoadedWorld
+from .xml_values import check_range, parse_float
 
 _logger = get_logger(__name__)
 
@@ -61,13 +62,28 @@ def frame_pose(client: BulletClient, body: int, frame_from_com: Pose) -> Pose:
     return compose(Pose(tuple(position), tuple(orientation)), frame_from_com)
 
 
-def frame_velocity(client: BulletClient, body: int, frame_position) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
-    """World-frame (linear velocity of a point fixed to the base, angular velocity): v_com + ω × r."""
-    com, _ = client.getBasePositionAndOrientation(body)
-    (vx, vy, vz), (wx, wy, wz) = client.getBaseVelocity(body)
-    rx, ry, rz = (frame_position[i] - com[i] for i in range(3))
+def _point_velocity(com, linear, angular, point) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
+    """(v_com + ω × r, ω) for a point fixed to a body; r from the centre of mass to the point."""
+    (vx, vy, vz), (wx, wy, wz) = linear, angular
+    rx, ry, rz = (point[i] - com[i] for i in range(3))
     # Written out: numpy.cross costs more than a physics step on 3-vectors.
     return (vx + wy * rz - wz * ry, vy + wz * rx - wx * rz, vz + wx * ry - wy * rx), (wx, wy, wz)
+
+
+def frame_velocity(client: BulletClient, body: int, frame_position) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
+    """World-frame (linear velocity of a point fixed to the base, angular velocity)."""
+    com, _ = client.getBasePositionAndOrientation(body)
+    linear, angular = client.getBaseVelocity(body)
+    return _point_velocity(com, linear, angular, frame_position)
+
+
+def _friction(text: str, model: str, link: str) -> float:
+    try:
+        value = parse_float(text)
+        check_range(value, minimum=0.0)
+    except ValueError as error:
+        raise ModelError("model '%s': <gazebo reference='%s'> friction '%s': %s" % (model, link, text, error)) from None
+    return value
 
 
 class SpawnedRobot:
@@ -113,10 +129,29 @@ class SpawnedRobot:
         states = self.client.getJointStates(self.body, [self.joint_index[name] for name in joint_names])
         return [(state[0], state[1], state[3]) for state in states]
 
+    def link_world_velocity(self, link_name: str):
+        """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
+        index = self.link_index[self.model.lumped_into[link_name][0]]
+        point = self.link_world_pose(link_name).position
+        if index == -1:
+            return frame_velocity(self.client, self.body, point)
+        state = self.client.getLinkState(self.body, index, computeLinkVelocity=True)
+        return _point_velocity(state[0], state[6], state[7], point)
+
     def set_joint_velocity(self, joint_name: str, velocity: float, max_force: float):
         """A velocity motor, as Gazebo's ODE joint 'vel' + 'fmax' pair."""
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.VELOCITY_CONTROL,
                                           targetVelocity=velocity, force=max_force)
+
+    def set_joint_position(self, joint_name: str, position: float, max_force: float):
+        """A position servo reaching ``position`` with at most ``max_force`` (N·m or N)."""
+        self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.POSITION_CONTROL,
+                                          targetPosition=position, force=max_force)
+
+    def set_joint_effort(self, joint_name: str, effort: float):
+        """A torque (or force) held until changed; PyBullet applies it only once the velocity motor is off."""
+        self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.TORQUE_CONTROL,
+                                          force=effort)
 
     def release_joint(self, joint_name: str):
         """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
@@ -159,17 +194,19 @@ class Engine:
         return list(self.world_bodies) + list(self.robots)
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/",
-                    driven_joints: Sequence[str] = ()) -> SpawnedRobot:
+                    driven_joints: Optional[Sequence[str]] = ()) -> SpawnedRobot:
+        """Load ``model`` as ``name``; ``driven_joints`` (those a plugin drives) decide which links are casters.
+
+        None leaves the surfaces to a later ``set_surfaces``, once the plugins have said what they drive.
+        """
         if name in self.robots or name in self.world_bodies:
             raise ModelError("model '%s' already exists" % name)
         body = self._load_urdf(model, pose)
         robot = SpawnedRobot(self.client, name, model, body, namespace, self._free_collision_group())
-        casters = set(model.caster_links(driven_joints))
-        if casters:
-            _logger.info("%s: ball-caster contact (frictionless) for %s", name, ", ".join(sorted(casters)))
-        for link_name, index in robot.link_index.items():
-            self._set_surface(robot, link_name, index, caster=link_name in casters)
+        for index in robot.link_index.values():
             self.client.setCollisionFilterGroupMask(body, index, robot.collision_group, -1)
+        if driven_joints is not None:
+            self.set_surfaces(robot, driven_joints)
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
         self.robots[name] = robot
@@ -247,12 +284,20 @@ class Engine:
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         return body
 
+    def set_surfaces(self, robot: SpawnedRobot, driven_joints: Sequence[str]):
+        """Friction of every link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
+        casters = set(robot.model.caster_links(driven_joints))
+        if casters:
+            _logger.info("%s: ball-caster contact (frictionless) for %s", robot.name, ", ".join(sorted(casters)))
+        for link_name, index in robot.link_index.items():
+            self._set_surface(robot, link_name, index, caster=link_name in casters)
+
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
         link = robot.model.links.get(link_name)
         mu = DEFAULT_MU
         if link is not None:
             mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
-            values = [float(v) for v in (mu1, mu2) if v is not None]
+            values = [_friction(v, robot.name, link_name) for v in (mu1, mu2) if v is not None]
             if len(values) == 2 and values[0] != values[1]:
                 warn_once(_logger, "%s: link '%s' has mu1 %s and mu2 %s; Bullet's friction is isotropic, the "
                           "smaller is used" % (robot.name, link_name, mu1, mu2))

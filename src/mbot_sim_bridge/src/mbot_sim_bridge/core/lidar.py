@@ -1,8 +1,9 @@
 """Gazebo's ray sensor (``type="ray"`` and ``"gpu_ray"``) on PyBullet ray casts.
 
-``parse_ray_sensor`` reads a ``<sensor>`` from a URDF ``<gazebo reference="LINK">`` block together with its
-``libgazebo_ros_laser.so`` or ``libgazebo_ros_gpu_laser.so`` plugin. ``LaserScanner`` casts the rays and
-turns the hits into ranges the way ``gazebo::sensors::RaySensor`` does:
+``parse_ray_sensor`` reads a ``<sensor>`` from a URDF ``<gazebo reference="LINK">`` block through the
+``RAY_SENSOR_PARAMS`` table; ``RaySensor`` is the core of ``libgazebo_ros_laser.so`` (and of
+``libgazebo_ros_gpu_laser.so``, served by the same CPU ray casts). ``LaserScanner`` casts the rays and turns
+the hits into ranges the way ``gazebo::sensors::RaySensor`` does:
 
 - Ray (j, i) points at yaw = min + i·(max − min)/(samples − 1) and at
   pitch = vmin + j·(vmax − vmin)/(vsamples − 1) in the sensor frame (yaw counter-clockwise about +z,
@@ -22,30 +23,50 @@ Two PyBullet behaviours at the ray start, measured with pybullet 3.2.7:
 - A ray that starts within about 1 mm of a surface reports hit fraction 0. That is raw = range_min, so the
   reading is −inf, as ODE gives for a ray that starts exactly on the surface.
 """
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Callable, NamedTuple, Optional
+from typing import NamedTuple, Optional
 
 import numpy as np
 import pybullet
 
-from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.geometry import IDENTITY, Pose, pose_from_xyz_rpy, rotation_matrix
-from mbot_sim_bridge.core.log import get_logger, warn_once
+from .clock import UpdateTimer
+from .errors import BridgeError, ConfigError
+from .geometry import IDENTITY, Pose, compose, rotation_matrix
+from .log import get_logger, info_once, warn_once
+from .params import Param, PluginParams, non_negative, positive
+from .plugin import Plugin
+from .xml_values import XmlDocument, read_pose
 
 _log = get_logger(__name__)
 
-# The sensor type each ROS 1 laser plugin needs; any other pairing is a load error in Gazebo.
-LASER_PLUGINS = {
-    "libgazebo_ros_laser.so": "ray",
-    "libgazebo_ros_gpu_laser.so": "gpu_ray",
-}
-PLUGIN_TAGS = ("frameName", "robotNamespace", "topicName")
-# gazebo_ros_laser.cpp defaults both the topic and the frame to "/world"; the topic default is a known
-# copy-paste slip, kept because Gazebo behaves that way.
-DEFAULT_TOPIC_NAME = "/world"
-DEFAULT_FRAME_NAME = "/world"
+# The <sensor> values of a ray sensor (SDF names and defaults; Gazebo does not warn about missing SDF tags).
+RAY_SENSOR_PARAMS = (
+    non_negative("update_rate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+    Param("ray/scan/horizontal/samples", int, None, "rays per sweep", required=True, minimum=1),
+    positive("ray/scan/horizontal/resolution", float, 1.0, "ranges per ray (interpolated)", warn_if_missing=False),
+    Param("ray/scan/horizontal/min_angle", float, None, "first ray (rad)", required=True),
+    Param("ray/scan/horizontal/max_angle", float, None, "last ray (rad)", required=True),
+    Param("ray/scan/vertical/samples", int, 1, "vertical layers", minimum=1, warn_if_missing=False),
+    positive("ray/scan/vertical/resolution", float, 1.0, "ranges per layer", warn_if_missing=False),
+    Param("ray/scan/vertical/min_angle", float, 0.0, "lowest layer (rad)", warn_if_missing=False),
+    Param("ray/scan/vertical/max_angle", float, 0.0, "highest layer (rad)", warn_if_missing=False),
+    non_negative("ray/range/min", float, None, "rays start here (m)", required=True),
+    positive("ray/range/max", float, None, "longest reading (m)", required=True),
+    non_negative("ray/range/resolution", float, 0.0, "reported only: Gazebo does not quantize with it",
+                 warn_if_missing=False),
+    Param("ray/noise/type", str, "gaussian", "gaussian or none", warn_if_missing=False),
+    Param("ray/noise/mean", float, 0.0, "m", warn_if_missing=False),
+    non_negative("ray/noise/stddev", float, 0.0, "m", warn_if_missing=False),
+)
+# libgazebo_ros_laser.so's tags. gazebo_ros_laser.cpp defaults both the topic and the frame to "/world"; the
+# topic default is a known copy-paste slip, kept because Gazebo behaves that way.
+LASER_PARAMS = (
+    Param("topicName", str, "/world", "sensor_msgs/LaserScan topic, relative to the namespace"),
+    Param("frameName", str, "/world", "frame_id of the scans (a leading '/' is dropped, as tf::resolve does)"),
+    Param("robotNamespace", str, "", "absent: the simulator's namespace; empty: the model name",
+          warn_if_missing=False),
+)
 
 # A batch of exactly MAX_RAY_INTERSECTION_BATCH_SIZE rays returns one result short in pybullet 3.2.7.
 _MAX_RAYS_PER_BATCH = pybullet.MAX_RAY_INTERSECTION_BATCH_SIZE - 1
@@ -72,11 +93,6 @@ class RaySensorConfig:
     range_resolution: float = 0.0  # reported in the message only; Gazebo does not quantize with it
     noise_mean: Optional[float] = None  # None: no gaussian noise
     noise_stddev: Optional[float] = None
-    plugin_filename: Optional[str] = None  # None: no ROS plugin, so nothing to publish
-    topic_name: str = DEFAULT_TOPIC_NAME
-    frame_name: str = "world"  # DEFAULT_FRAME_NAME as tf::resolve leaves it
-    robot_namespace: Optional[str] = None  # None: tag absent
-    is_gpu: bool = False
 
     @property
     def range_count(self) -> int:
@@ -104,189 +120,58 @@ class Scan(NamedTuple):
 
 # --- parsing ---------------------------------------------------------------------------------------------
 
-_REQUIRED = object()
+def parse_ray_sensor(sensor_element: ET.Element, link_name: str, document: XmlDocument) -> RaySensorConfig:
+    """Read ``<sensor type="ray"|"gpu_ray">`` from ``<gazebo reference="link_name">`` of ``document``.
 
-
-def _finite(text: str) -> Optional[float]:
-    value = float(text)
-    return value if math.isfinite(value) else None
-
-
-def _non_negative(text: str) -> Optional[float]:
-    value = _finite(text)
-    return value if value is not None and value >= 0.0 else None
-
-
-def _positive(text: str) -> Optional[float]:
-    value = _finite(text)
-    return value if value is not None and value > 0.0 else None
-
-
-def _positive_int(text: str) -> Optional[int]:
-    value = int(text)
-    return value if value > 0 else None
-
-
-# parser -> what the error message says the value must be
-_KINDS = {
-    _finite: "a finite number",
-    _non_negative: "a non-negative number",
-    _positive: "a positive number",
-    _positive_int: "a positive integer",
-}
-
-
-def _read(element: ET.Element, path: str, tag: str, where: str, parse: Callable, default=_REQUIRED):
-    """The value at ``path`` below ``element``; ``tag`` is how error messages name it."""
-    node = element.find(path)
-    if node is None:
-        if default is _REQUIRED:
-            raise ConfigError(f"{where}: missing {tag}")
-        return default
-    text = (node.text or "").strip()
-    try:
-        value = parse(text)
-    except ValueError:
-        value = None
-    if value is None:
-        raise ConfigError(f"{where}: {tag} must be {_KINDS[parse]}, got '{text}'")
-    return value
-
-
-def _block(element: ET.Element, path: str, where: str) -> ET.Element:
-    node = element.find(path)
-    if node is None:
-        raise ConfigError(f"{where}: missing <{path.replace('/', '><')}>")
-    return node
-
-
-def _read_pose(sensor: ET.Element, where: str) -> Pose:
-    node = sensor.find("pose")
-    if node is None:
-        return IDENTITY
-    text = (node.text or "").strip()
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        values = []
-    if len(values) != 6 or not all(math.isfinite(v) for v in values):
-        raise ConfigError(f"{where}: <pose> must be six numbers 'x y z roll pitch yaw', got '{text}'")
-    return pose_from_xyz_rpy(values[:3], values[3:])
-
-
-def _read_noise(ray: ET.Element, where: str):
-    """(mean, stddev) of the gaussian ray noise, or (None, None) when there is none to simulate."""
-    noise = ray.find("noise")
-    if noise is None:
-        return None, None
-    # "gaussian" is the SDF default of <ray><noise><type>.
-    noise_type = (noise.findtext("type") or "gaussian").strip()
-    if noise_type == "none":
-        return None, None
-    if noise_type != "gaussian":
-        warn_once(_log, f"{where}: <noise><type> '{noise_type}' is not supported (only gaussian is); "
-                        f"the scan is noise-free")
-        return None, None
-    return (_read(noise, "mean", "<noise><mean>", where, _finite, 0.0),
-            _read(noise, "stddev", "<noise><stddev>", where, _non_negative, 0.0))
-
-
-def _plugin_text(plugin: ET.Element, tag: str, default: str, label: str) -> str:
-    node = plugin.find(tag)
-    if node is None:
-        warn_once(_log, f"{label}: missing <{tag}>, default is {default}")
-        return default
-    text = (node.text or "").strip()
-    if not text:
-        raise ConfigError(f"{label}: <{tag}> must not be empty")
-    return text
-
-
-def _read_plugin(sensor: ET.Element, sensor_type: str, where: str) -> dict:
-    """Config fields from the sensor's ROS laser plugin; Gazebo's defaults when it has none."""
-    plugins = sensor.findall("plugin")
-    lasers = [p for p in plugins if p.get("filename") in LASER_PLUGINS]
-    for plugin in plugins:
-        if plugin.get("filename") not in LASER_PLUGINS:
-            warn_once(_log, f"{where}: plugin '{plugin.get('filename')}' is not emulated; it is ignored "
-                            f"(supported: {', '.join(sorted(LASER_PLUGINS))})")
-    if not lasers:
-        return {}
-    if len(lasers) > 1:
-        warn_once(_log, f"{where}: {len(lasers)} laser plugins; only the first, "
-                        f"{lasers[0].get('filename')}, is emulated")
-    plugin = lasers[0]
-    filename = plugin.get("filename")
-    label = f"{where}: {filename}"
-    if LASER_PLUGINS[filename] != sensor_type:
-        raise ConfigError(f"{label} needs <sensor type=\"{LASER_PLUGINS[filename]}\">, "
-                          f"but the sensor's type is \"{sensor_type}\"")
-    for child in plugin:
-        if isinstance(child.tag, str) and child.tag not in PLUGIN_TAGS:  # not an XML comment
-            warn_once(_log, f"{label}: unknown tag <{child.tag}> ignored; "
-                            f"known tags: {', '.join(PLUGIN_TAGS)}")
-    namespace = plugin.find("robotNamespace")
-    frame_name = _plugin_text(plugin, "frameName", DEFAULT_FRAME_NAME, label)
-    return {
-        "plugin_filename": filename,
-        "topic_name": _plugin_text(plugin, "topicName", DEFAULT_TOPIC_NAME, label),
-        # tf::resolve with the (normally empty) tf_prefix strips one leading "/".
-        "frame_name": frame_name[1:] if frame_name.startswith("/") else frame_name,
-        "robot_namespace": None if namespace is None else (namespace.text or "").strip(),
-    }
-
-
-def parse_ray_sensor(sensor_element: ET.Element, link_name: str, source_label: str) -> RaySensorConfig:
-    """Read ``<sensor type="ray"|"gpu_ray">`` from ``<gazebo reference="link_name">``.
-
-    ``source_label`` names the document in error messages (e.g. "robot_description"). Bad values raise
-    ``ConfigError`` naming the tag, the value and the sensor; unsupported plugins, plugin tags and noise
-    types are logged once and ignored.
+    Bad values raise ``ConfigError`` naming where, the sensor, the tag, the value and the valid range;
+    unsupported noise types are logged once and ignored.
     """
     name = sensor_element.get("name")
+    where = document.where(sensor_element)
     if not name:
-        raise ConfigError(f"{source_label}: a <sensor> on link '{link_name}' has no name")
-    where = f"{source_label}: lidar '{name}' on link '{link_name}'"
-    sensor_type = sensor_element.get("type")
-    if sensor_type not in LASER_PLUGINS.values():
-        raise ConfigError(f"{where}: type '{sensor_type}' is not a ray sensor (expected 'ray' or 'gpu_ray')")
-
-    ray = _block(sensor_element, "ray", where)
-    horizontal = _block(ray, "scan/horizontal", where)
-    vertical = ray.find("scan/vertical")
-    range_ = _block(ray, "range", where)
-    noise_mean, noise_stddev = _read_noise(ray, where)
+        raise ConfigError(f"{where}: a <sensor> on link '{link_name}' has no name")
+    label = f"lidar '{name}' on link '{link_name}'"
+    if sensor_element.get("type") not in ("ray", "gpu_ray"):
+        raise ConfigError(f"{where}: {label}: type '{sensor_element.get('type')}' is not a ray sensor "
+                          f"(expected 'ray' or 'gpu_ray')")
+    values = PluginParams(sensor_element, label, where=where, check_unknown=False).read(RAY_SENSOR_PARAMS)
+    try:
+        pose = read_pose(sensor_element.find("pose"), document)
+    except BridgeError as error:
+        raise ConfigError(f"{where}: {label}: {str(error).split(': ', 1)[1]}") from None
+    noise_mean, noise_stddev = _noise(sensor_element, values, f"{where}: {label}")
     config = RaySensorConfig(
         sensor_name=name,
         link=link_name,
-        pose=_read_pose(sensor_element, where),
-        update_rate=_read(sensor_element, "update_rate", "<update_rate>", where, _non_negative, 0.0),
-        samples=_read(horizontal, "samples", "<samples>", where, _positive_int),
-        resolution=_read(horizontal, "resolution", "<resolution>", where, _positive, 1.0),
-        min_angle=_read(horizontal, "min_angle", "<min_angle>", where, _finite),
-        max_angle=_read(horizontal, "max_angle", "<max_angle>", where, _finite),
-        range_min=_read(range_, "min", "<range><min>", where, _non_negative),
-        range_max=_read(range_, "max", "<range><max>", where, _positive),
-        range_resolution=_read(range_, "resolution", "<range><resolution>", where, _non_negative, 0.0),
+        pose=pose,
+        update_rate=values["update_rate"],
+        samples=values["ray/scan/horizontal/samples"],
+        resolution=values["ray/scan/horizontal/resolution"],
+        min_angle=values["ray/scan/horizontal/min_angle"],
+        max_angle=values["ray/scan/horizontal/max_angle"],
+        vertical_samples=values["ray/scan/vertical/samples"],
+        vertical_resolution=values["ray/scan/vertical/resolution"],
+        vertical_min_angle=values["ray/scan/vertical/min_angle"],
+        vertical_max_angle=values["ray/scan/vertical/max_angle"],
+        range_min=values["ray/range/min"],
+        range_max=values["ray/range/max"],
+        range_resolution=values["ray/range/resolution"],
         noise_mean=noise_mean,
         noise_stddev=noise_stddev,
-        is_gpu=sensor_type == "gpu_ray",
-        **_read_vertical(vertical, where),
-        **_read_plugin(sensor_element, sensor_type, where),
     )
-    _check_consistency(config, where)
+    _check_consistency(config, f"{where}: {label}")
     return config
 
 
-def _read_vertical(vertical: Optional[ET.Element], where: str) -> dict:
-    if vertical is None:
-        return {}
-    return {
-        "vertical_samples": _read(vertical, "samples", "<vertical><samples>", where, _positive_int, 1),
-        "vertical_resolution": _read(vertical, "resolution", "<vertical><resolution>", where, _positive, 1.0),
-        "vertical_min_angle": _read(vertical, "min_angle", "<vertical><min_angle>", where, _finite, 0.0),
-        "vertical_max_angle": _read(vertical, "max_angle", "<vertical><max_angle>", where, _finite, 0.0),
-    }
+def _noise(sensor: ET.Element, values: dict, where: str):
+    """(mean, stddev) of the gaussian ray noise, or (None, None) when there is none to simulate."""
+    if sensor.find("ray/noise") is None or values["ray/noise/type"] == "none":
+        return None, None
+    if values["ray/noise/type"] != "gaussian":
+        warn_once(_log, f"{where}: <noise><type> '{values['ray/noise/type']}' is not supported (only gaussian "
+                        f"is); the scan is noise-free")
+        return None, None
+    return values["ray/noise/mean"], values["ray/noise/stddev"]
 
 
 def _check_consistency(config: RaySensorConfig, where: str) -> None:
@@ -305,6 +190,36 @@ def _check_consistency(config: RaySensorConfig, where: str) -> None:
     if config.vertical_range_count < 1:
         raise ConfigError(f"{where}: <vertical><samples> × <vertical><resolution> = "
                           f"{config.vertical_samples * config.vertical_resolution} leaves no ranges")
+
+
+class RaySensor(Plugin):
+    """Core of libgazebo_ros_laser.so: the sensor's rays, cast from its link, never hitting its own robot."""
+
+    GAZEBO_CLASS = "GazeboRosLaser"
+    PARAMS = LASER_PARAMS
+    SENSOR_TYPES = ("ray", "gpu_ray")
+    SENSOR_PARAMS = RAY_SENSOR_PARAMS
+
+    def __init__(self, context, element, sensor):
+        super().__init__(context, element, sensor)
+        robot = context.robot
+        self.config = parse_ray_sensor(sensor, context.link, robot.model.document)
+        self.params = self.read_params()
+        if sensor.get("type") == "gpu_ray":
+            info_once(_log, f"{self.label}: sensor '{self.config.sensor_name}' is a gpu_ray; the bridge casts its "
+                            f"rays on the CPU, with the same ranges")
+        self.scanner = LaserScanner(robot.client, self.config, context.random_stream(self.config.sensor_name))
+        self.timer = UpdateTimer(self.config.update_rate, start=context.simulation.sim_time)
+        # Everything but this robot's own bit: the scan never sees the robot that carries the sensor.
+        self.collision_filter_mask = -1 & ~robot.collision_group
+        self.latest: Optional[Scan] = None
+
+    def scan(self) -> "Scan":
+        pose = compose(self.context.robot.link_world_pose(self.config.link), self.config.pose)
+        return self.scanner.scan(pose, self.collision_filter_mask)
+
+    def update(self, now: float):
+        self.latest = self.scan()
 
 
 # --- scanning --------------------------------------------------------------------------------------------

@@ -15,13 +15,21 @@ def get_logger(module_name: str) -> logging.Logger:
     return logging.getLogger("rosout." + module_name)
 
 
-def warn_once(logger: logging.Logger, message: str) -> None:
-    """Log ``message`` at WARNING the first time this exact text is seen in the process."""
+def log_once(logger: logging.Logger, level: int, message: str) -> None:
+    """Log ``message`` at ``level`` the first time this exact text is seen in the process."""
     with _warned_lock:
         if message in _warned:
             return
         _warned.add(message)
-    logger.warning(message)
+    logger.log(level, message)
+
+
+def warn_once(logger: logging.Logger, message: str) -> None:
+    log_once(logger, logging.WARNING, message)
+
+
+def info_once(logger: logging.Logger, message: str) -> None:
+    log_once(logger, logging.INFO, message)
 
 
 def forget_warnings() -> None:

@@ -1,46 +1,27 @@
-"""Plugin tags read the way gazebo_ros's ``GazeboRos::getParameter`` reads them.
+"""Plugin and sensor tags read the way gazebo_ros's ``GazeboRos::getParameter`` reads them.
 
-Each plugin declares its tags once, as a tuple of ``Param``; defaults, warnings, docs and tests all come from
-that table. A missing tag warns with its default (as Gazebo does), a bad value raises ``ConfigError`` naming
-the tag, the value and the plugin, and an unknown tag warns once and lists the known ones.
+Each plugin declares its tags once, as a tuple of ``Param``; defaults, valid ranges, warnings, docs and tests
+all come from that table. A missing tag warns with its default (as Gazebo does); a bad or out-of-range value
+raises ``ConfigError`` naming where it is, the plugin, the tag, the value and the valid range; an unknown tag
+warns once and lists the known ones. Gazebo accepts out-of-range numbers and then divides by zero or flies
+the robot off; the bridge refuses the spawn instead.
 """
-import math
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, Optional, Sequence, Tuple
 from xml.etree import ElementTree
 
 from .errors import ConfigError
-from .log import get_logger, warn_once
+from .log import get_logger, info_once, warn_once
+from .xml_values import check_range, describe_range, parse_bool, parse_float, parse_int
 
 _logger = get_logger(__name__)
 
-_TRUE = ("true", "1")
-_FALSE = ("false", "0")
-
-
-def parse_bool(text: str) -> bool:
-    """Gazebo accepts true/false/1/0 in any case."""
-    value = text.strip().lower()
-    if value in _TRUE:
-        return True
-    if value in _FALSE:
-        return False
-    raise ValueError("expected true, false, 1 or 0")
-
-
-def parse_float(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError("expected a finite number")
-    return value
-
-
-_PARSERS: Dict[type, Callable[[str], Any]] = {bool: parse_bool, float: parse_float, int: int, str: str.strip}
+_PARSERS: Dict[type, Callable[[str], Any]] = {bool: parse_bool, float: parse_float, int: parse_int, str: str.strip}
 
 
 @dataclass(frozen=True)
 class Param:
-    tag: str
+    tag: str  # a child of the element read, or a path below it ("ray/range/min")
     kind: type
     default: Any = None
     doc: str = ""
@@ -48,53 +29,83 @@ class Param:
     choices: Optional[Tuple[str, ...]] = None
     # False for tags Gazebo reads without a warning when absent (e.g. the diff drive's publishOdomTF).
     warn_if_missing: bool = True
+    minimum: Optional[float] = None
+    maximum: Optional[float] = None
+    exclusive_minimum: bool = False  # True: value > minimum
+
+    @property
+    def valid_range(self) -> str:
+        if self.choices is not None:
+            return "one of " + ", ".join(self.choices)
+        if self.kind in (int, float):
+            return describe_range(self.minimum, self.maximum, self.exclusive_minimum)
+        return ""
+
+
+def positive(tag: str, kind: type, default: Any, doc: str = "", **options) -> Param:
+    """A number that must be > 0 (a length, a rate that cannot be zero)."""
+    return Param(tag, kind, default, doc, minimum=0, exclusive_minimum=True, **options)
+
+
+def non_negative(tag: str, kind: type, default: Any, doc: str = "", **options) -> Param:
+    return Param(tag, kind, default, doc, minimum=0, **options)
 
 
 class PluginParams:
-    """Reads one ``<plugin>`` element against a Param table. ``label`` names the plugin in every message."""
+    """Reads one ``<plugin>`` (or ``<sensor>``) element against a Param table.
 
-    def __init__(self, element: ElementTree.Element, label: str, ignored: Sequence[str] = ()):
+    ``label`` names the plugin in every message ("GazeboRosDiffDrive(ns = /)"); ``where`` locates the
+    element ("model 'mbot':57"). ``check_unknown`` warns about children no Param names (plugins; a
+    sensor's SDF has many tags read elsewhere or by Gazebo's rendering, so sensors skip it).
+    """
+
+    def __init__(self, element: ElementTree.Element, label: str, ignored: Sequence[str] = (), where: str = "",
+                 check_unknown: bool = True):
         self._element = element
         self.label = label
+        self._prefix = f"{where}: {label}" if where else label
         self._ignored = tuple(ignored)
+        self._check_unknown = check_unknown
 
     def read(self, params: Sequence[Param]) -> Dict[str, Any]:
         values = {param.tag: self._read_one(param) for param in params}
-        known = {param.tag for param in params} | set(self._ignored)
-        for child in self._element:
-            if not isinstance(child.tag, str):
-                continue  # an XML comment
-            if child.tag in self._ignored:
-                _logger.debug("%s: <%s> is accepted and has no effect, as in gazebo_ros", self.label, child.tag)
-            elif child.tag not in known:
-                warn_once(_logger, "%s: unknown tag <%s> ignored; known tags: %s"
-                          % (self.label, child.tag, ", ".join(sorted(known))))
+        if self._check_unknown:
+            known = {param.tag for param in params} | set(self._ignored)
+            for child in self._element:
+                if child.tag in self._ignored:
+                    info_once(_logger, f"{self.label}: <{child.tag}> is accepted and has no effect, "
+                                       f"as in gazebo_ros")
+                elif child.tag not in known:
+                    warn_once(_logger, f"{self.label}: unknown tag <{child.tag}> ignored; known tags: "
+                                       f"{', '.join(sorted(known))}")
         return values
 
     def _read_one(self, param: Param) -> Any:
         child = self._element.find(param.tag)
         if child is None or child.text is None or not child.text.strip():
             if param.required:
-                raise ConfigError("%s: missing required tag <%s>" % (self.label, param.tag))
+                raise ConfigError(f"{self._prefix}: missing required tag <{param.tag}>")
             if param.warn_if_missing:
-                warn_once(_logger, "%s: missing <%s>, default is %s" % (self.label, param.tag, param.default))
+                warn_once(_logger, f"{self.label}: missing <{param.tag}>, default is {param.default}")
             return param.default
         text = child.text.strip()
         try:
             value = _PARSERS[param.kind](text)
+            if param.kind in (int, float):
+                check_range(value, param.minimum, param.maximum, param.exclusive_minimum)
         except ValueError as error:
-            raise ConfigError("%s: <%s> has bad value '%s': %s" % (self.label, param.tag, text, error)) from None
+            raise ConfigError(f"{self._prefix}: <{param.tag}> has bad value '{text}': {error}") from None
         if param.choices is not None and value not in param.choices:
-            raise ConfigError("%s: <%s> is '%s'; expected one of %s"
-                              % (self.label, param.tag, value, ", ".join(param.choices)))
+            raise ConfigError(f"{self._prefix}: <{param.tag}> is '{value}'; expected one of "
+                              f"{', '.join(param.choices)}")
         _logger.debug("%s: <%s> = %s", self.label, param.tag, value)
         return value
 
 
 def params_table_markdown(params: Sequence[Param]) -> str:
     """The README table of a plugin's tags, generated from the same data the plugin reads."""
-    rows = ["| Tag | Type | Default | Meaning |", "|-----|------|---------|---------|"]
+    rows = ["| Tag | Type | Default | Valid | Meaning |", "|-----|------|---------|-------|---------|"]
     for param in params:
         default = "(required)" if param.required else repr(param.default)
-        rows.append("| `%s` | %s | %s | %s |" % (param.tag, param.kind.__name__, default, param.doc))
+        rows.append(f"| `{param.tag}` | {param.kind.__name__} | {default} | {param.valid_range} | {param.doc} |")
     return "\n".join(rows)

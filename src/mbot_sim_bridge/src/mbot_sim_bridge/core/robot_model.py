@@ -8,13 +8,16 @@ Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
 - a link with no ``<inertial>`` on a moving joint is not simulated, together with its subtree (with a warning);
 - ``<gazebo reference="...">`` blocks are collected per link; model-level ``<gazebo>`` blocks carry plugins.
 """
+import copy
+import math
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 from xml.etree import ElementTree
 
 from .errors import ModelError
-from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
+from .geometry import IDENTITY, Pose, compose
 from .log import get_logger, warn_once
+from .xml_values import XmlDocument, parse_xml, read_attribute_numbers, read_origin
 
 _logger = get_logger(__name__)
 
@@ -22,8 +25,11 @@ MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
 # PyBullet's URDF importer knows these; planar and floating joints are not importable into a multibody.
 SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
 
-# <gazebo reference="link"> tags the bridge acts on, and those it reads but that change nothing in Bullet.
-LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor", "turnGravityOff", "gravity", "selfCollide")
+# <gazebo reference="link"> tags the bridge acts on.
+LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor")
+# Tags whose Gazebo default is what Bullet does anyway: only another value is reported (value -> default).
+LINK_TAGS_DEFAULT_ONLY = {"turnGravityOff": "false", "gravity": "true", "selfCollide": "false"}
+# Tags read by Gazebo's URDF import that have no Bullet counterpart here: one warning per tag and model.
 LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", "maxContacts", "dampingFactor",
                        "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
                        "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
@@ -60,6 +66,11 @@ class Joint:
     child: str
     origin: Pose
     axis: Tuple[float, float, float]
+    # URDF <limit>: lower/upper (rad or m; -inf/inf when absent or continuous), effort and velocity (0 = none given)
+    lower: float = -math.inf
+    upper: float = math.inf
+    effort: float = 0.0
+    velocity: float = 0.0
 
     @property
     def movable(self) -> bool:
@@ -76,6 +87,8 @@ class RobotModel:
     # For every URDF link: (the simulated link it is lumped into, its pose in that link's frame).
     lumped_into: Dict[str, Tuple[str, Pose]]
     pybullet_urdf: str
+    transmissions: List[ElementTree.Element]
+    document: XmlDocument  # the parsed robot_description: line numbers for messages
 
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
@@ -102,41 +115,32 @@ class RobotModel:
         return casters
 
 
-def _floats(text: Optional[str], count: int, default: float, where: str) -> Tuple[float, ...]:
-    if text is None:
-        return (default,) * count
-    try:
-        values = tuple(float(v) for v in text.split())
-    except ValueError:
-        raise ModelError("%s: expected %d numbers, got '%s'" % (where, count, text)) from None
-    if len(values) != count:
-        raise ModelError("%s: expected %d numbers, got '%s'" % (where, count, text))
-    return values
-
-
-def _origin(element: ElementTree.Element, where: str) -> Pose:
-    origin = element.find("origin")
-    if origin is None:
-        return IDENTITY
-    return pose_from_xyz_rpy(_floats(origin.get("xyz"), 3, 0.0, where + " <origin xyz>"),
-                             _floats(origin.get("rpy"), 3, 0.0, where + " <origin rpy>"))
-
-
-def _parse_xml(urdf_xml: str, source: str) -> ElementTree.Element:
+def _parse_document(urdf_xml: str, source: str) -> XmlDocument:
     if not urdf_xml or not urdf_xml.strip():
         raise ModelError("%s is empty" % source)
-    try:
-        root = ElementTree.fromstring(urdf_xml)
-    except ElementTree.ParseError as error:
-        raise ModelError("%s is not valid XML: %s" % (source, error)) from None
-    if root.tag != "robot":
-        raise ModelError("%s is not URDF: its root element is <%s>, not <robot>" % (source, root.tag))
-    return root
+    document = parse_xml(urdf_xml.encode(), source, ModelError)
+    if document.root.tag != "robot":
+        raise ModelError("%s is not URDF: its root element is <%s>, not <robot>" % (source, document.root.tag))
+    return document
+
+
+def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDocument) -> dict:
+    limit = element.find("limit")
+    if limit is None:
+        return {}
+    lower, upper, effort, velocity = (read_attribute_numbers(limit, name, document, (default,), 1)[0]
+                                      for name, default in (("lower", 0.0), ("upper", 0.0), ("effort", 0.0),
+                                                            ("velocity", 0.0)))
+    values = {"effort": effort, "velocity": velocity}
+    if joint_type != "continuous":
+        values.update(lower=lower, upper=upper)
+    return values
 
 
 def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     """Parse and check a URDF string; ``source`` names it in every error ("robot_description", a file)."""
-    root = _parse_xml(urdf_xml, source)
+    document = _parse_document(urdf_xml, source)
+    root = document.root
     name = root.get("name") or "robot"
     links: Dict[str, Link] = {}
     for element in root.findall("link"):
@@ -146,7 +150,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         inertial = element.find("inertial")
         mass = 0.0
         if inertial is not None and inertial.find("mass") is not None:
-            mass = _floats(inertial.find("mass").get("value"), 1, 0.0, "%s link '%s' <mass>" % (source, link_name))[0]
+            mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
         kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
                  if geometry is not None and len(geometry)]
         links[link_name] = Link(link_name, inertial is not None and mass > 0, mass, kinds)
@@ -169,9 +173,10 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
                 raise ModelError("%s: %s link '%s' is not defined" % (where, role, link_name))
         axis = element.find("axis")
         joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
-                                   _origin(element, where),
-                                   _floats(axis.get("xyz") if axis is not None else None, 3, 0.0, where + " <axis>")
-                                   if axis is not None else (1.0, 0.0, 0.0))
+                                   read_origin(element, document),
+                                   read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
+                                   if axis is not None else (1.0, 0.0, 0.0),
+                                   **_joint_limits(element, joint_type, document))
 
     children = {joint.child for joint in joints.values()}
     roots = [link_name for link_name in links if link_name not in children]
@@ -179,10 +184,11 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         raise ModelError("%s: expected one root link, found %s" % (source, ", ".join(roots) or "none (a loop)"))
 
     plugins = _collect_gazebo_blocks(root, links, joints, source)
+    transmissions = root.findall("transmission")
     dropped = _drop_massless_moving_links(links, joints, source)
     lumped_into = _lump_fixed_links(roots[0], links, joints)
     return RobotModel(name, roots[0], links, joints, plugins, lumped_into,
-                      _pybullet_urdf(root, links, dropped))
+                      _pybullet_urdf(root, links, dropped), transmissions, document)
 
 
 def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:
@@ -193,19 +199,33 @@ def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Elem
             for child in block:
                 if child.tag == "plugin":
                     plugins.append(child)
-                elif isinstance(child.tag, str) and child.tag != "static":
+                elif child.tag != "static":
                     warn_once(_logger, "%s: model-level <gazebo> tag <%s> is not supported; ignored"
                               % (source, child.tag))
             continue
         if reference in links:
             links[reference].gazebo.append(block)
             for child in block:
-                if isinstance(child.tag, str) and child.tag not in LINK_TAGS_USED + LINK_TAGS_NO_EFFECT:
-                    warn_once(_logger, "%s: <gazebo reference='%s'> tag <%s> is not supported; ignored"
-                              % (source, reference, child.tag))
+                _check_link_tag(child, reference, source)
         elif reference not in joints:
             warn_once(_logger, "%s: <gazebo reference='%s'> names no link or joint; ignored" % (source, reference))
     return plugins
+
+
+def _check_link_tag(child: ElementTree.Element, reference: str, source: str):
+    """Say once per tag and model what a <gazebo reference> tag that the bridge does not act on means."""
+    where = "%s: <gazebo reference='%s'> <%s>" % (source, reference, child.tag)
+    if child.tag in LINK_TAGS_USED:
+        return
+    if child.tag in LINK_TAGS_DEFAULT_ONLY:
+        if (child.text or "").strip().lower() not in (LINK_TAGS_DEFAULT_ONLY[child.tag],
+                                                      "0" if LINK_TAGS_DEFAULT_ONLY[child.tag] == "false" else "1"):
+            warn_once(_logger, "%s%s</%s> is not simulated; Gazebo's default applies"
+                      % (where, (child.text or "").strip(), child.tag))
+    elif child.tag in LINK_TAGS_NO_EFFECT:
+        warn_once(_logger, "%s has no Bullet counterpart; ignored" % where)
+    else:
+        warn_once(_logger, "%s is not supported; ignored" % where)
 
 
 def _subtree(link_name, joints) -> List[str]:
@@ -252,6 +272,7 @@ def _lump_fixed_links(root_name, links, joints) -> Dict[str, Tuple[str, Pose]]:
 
 def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str]) -> str:
     """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless."""
+    root = copy.deepcopy(root)
     for element in list(root):
         if element.tag in ("gazebo", "transmission"):
             root.remove(element)

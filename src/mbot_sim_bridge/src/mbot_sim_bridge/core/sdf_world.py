@@ -301,7 +301,8 @@ class _WorldParser:
     def _best_model_file(self, directory: str) -> str:
         """model.config lists one model file per SDF version: take the newest this reader follows."""
         config_path = next((os.path.join(directory, manifest) for manifest in MODEL_MANIFESTS
-                            if os.path.isfile(os.path.join(directory, manifest))), os.path.join(directory, "model.config"))
+                            if os.path.isfile(os.path.join(directory, manifest))),
+                           os.path.join(directory, "model.config"))
         config = self._read(config_path)
         choices = [(_version(entry.get("version", "")), (entry.text or "").strip())
                    for entry in config.root.iter("sdf") if (entry.text or "").strip()]
@@ -493,7 +494,8 @@ class _WorldParser:
 
     def _physics(self, document: XmlDocument, world: ET.Element) -> PhysicsConfig:
         candidates = world.findall("physics")
-        chosen = next((p for p in candidates if read_bool_attribute(p, "default")), candidates[0] if candidates else None)
+        chosen = next((p for p in candidates if read_bool_attribute(p, "default")),
+                      candidates[0] if candidates else None)
         defaults = PhysicsConfig()
         values = {}
         if chosen is not None:

@@ -87,7 +87,8 @@ def parse_floats(text: str, count: Optional[int] = None) -> Tuple[float, ...]:
     try:
         values = tuple(float(word) for word in words)
     except ValueError:
-        raise ValueError(f"expected numbers, got '{text.strip()}'") from None
+        wanted = "a number" if count == 1 else f"{count} numbers" if count else "numbers"
+        raise ValueError(f"expected {wanted}, got '{text.strip()}'") from None
     for value in values:
         if math.isnan(value):
             raise ValueError(f"NaN is not a valid value: '{text.strip()}'")

@@ -1,18 +1,13 @@
 """The ROS side of the emulated gazebo_ros plugins: one module and class per Gazebo ``.so``.
 
-A plugin reads its tags through the core's Param tables, takes core objects (engine, robot, timers) and
-only publishes and subscribes. The node calls ``update`` when the plugin's timer is due, in the thread
-that owns the engine.
+Each class extends the plugin's core class (``core/``) with its publishers and subscribers and nothing else;
+``registry.REGISTRY`` maps the Gazebo file name to it. Updates run in the loop thread that owns the engine;
+subscriber callbacks only store values under the core's lock.
 """
 import warnings
-from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Optional
 
 import rospy
-from tf2_msgs.msg import TFMessage
-
-from ..core.clock import UpdateTimer
-from ..core.engine import Engine, SpawnedRobot
 
 
 def loop_publisher(name: str, message_type) -> rospy.Publisher:
@@ -27,45 +22,9 @@ def loop_publisher(name: str, message_type) -> rospy.Publisher:
         return rospy.Publisher(name, message_type, queue_size=None)
 
 
-class TransformBroadcaster:
-    """tf2_ros.TransformBroadcaster's job (a TFMessage on /tf) through a loop publisher."""
-
-    def __init__(self):
-        self.publisher = loop_publisher("/tf", TFMessage)
-
-    def send_transform(self, transform):
-        self.publisher.publish(TFMessage([transform]))
-
-
-@dataclass
-class PluginContext:
-    engine: Engine
-    robot: SpawnedRobot
-    tf_broadcaster: TransformBroadcaster  # shared by all plugins
-    stamp: Callable[[], rospy.Time]  # the current sim time as a ROS stamp
-
-
-class BridgePlugin:
-    """Base of every emulated plugin."""
-
-    timer: UpdateTimer
-    # True when the plugin must see every physics step (the diff drive's encoder odometry).
-    needs_every_step = False
-    # Joints whose states the plugin publishes; the bridge publishes the other movable joints itself.
-    joint_states_published = ()
-
-    def on_step(self, step_size: float):
-        """Called after every physics step when ``needs_every_step``."""
-
-    def update(self, now: float):
-        """Called when ``timer`` is due, with the sim time in seconds."""
-
-    def reset(self, now: float):
-        """World or simulation reset (Gazebo calls the plugin's Reset())."""
-        self.timer.reset(now)
-
-    def close(self):
-        """The model is deleted or the node stops: drop publishers and subscribers."""
+def ros_time(sim_seconds: float) -> rospy.Time:
+    """A stamp for sim time: plugins stamp with the simulation's time, never rospy.Time.now()."""
+    return rospy.Time(*divmod(int(round(sim_seconds * 1e9)), 1000000000))
 
 
 def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
@@ -78,3 +37,11 @@ def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
 def resolve_frame(frame: str) -> str:
     """tf::resolve with an empty tf_prefix: a leading '/' is stripped."""
     return frame.lstrip("/")
+
+
+def sensor_namespace(plugin) -> str:
+    """A sensor plugin's namespace: absent means the simulator's own ("/"), empty means the model name."""
+    namespace = plugin.namespace_tag()
+    if namespace is None:
+        return "/"
+    return namespace or plugin.context.model.name

@@ -1,0 +1,39 @@
+"""``libgazebo_ros_joint_state_publisher.so`` without ROS: the named joints' states at ``updateRate``.
+
+The bridge also adds one to every robot for the movable joints no other plugin publishes: Gazebo leaves
+them to joint_state_publisher, which can only publish zeros (the course's caster, and the wheels fighting
+the diff drive), so robot_state_publisher would not see the simulated joints.
+"""
+from .clock import UpdateTimer
+from .errors import ConfigError
+from .params import Param
+from .plugin import Plugin
+
+JOINT_STATE_PARAMS = (
+    Param("jointName", str, "", "joints to publish, separated by commas"),
+    Param("updateRate", float, 100.0, "Hz of sim time; ≤ 0 = every physics step"),
+    Param("robotNamespace", str, "", "namespace of joint_states; spawn_model sets it", warn_if_missing=False),
+)
+
+
+class JointStatePublisher(Plugin):
+    GAZEBO_CLASS = "GazeboRosJointStatePublisher"
+    PARAMS = JOINT_STATE_PARAMS
+
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        params = self.read_params()
+        self.namespace = params["robotNamespace"] or context.model.name
+        self.joint_names = [name.strip() for name in params["jointName"].split(",") if name.strip()]
+        unknown = [name for name in self.joint_names if name not in context.robot.joint_index]
+        if unknown:
+            raise ConfigError("%s: %s: <jointName> names %s, which the robot does not have; movable joints: %s"
+                              % (context.where(element), self.label, ", ".join(unknown),
+                                 ", ".join(context.robot.movable_joints) or "none"))
+        self.joint_states_published = tuple(self.joint_names)
+        # Strict like the diff drive's timer (one step after each period), so both publish in the same pass.
+        self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
+
+    def states(self):
+        """(position, velocity, effort) of each joint, in ``joint_names`` order."""
+        return self.context.robot.joint_state(self.joint_names)

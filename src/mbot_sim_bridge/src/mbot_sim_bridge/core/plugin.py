@@ -1,0 +1,96 @@
+"""What every emulated Gazebo plugin is: a ``Plugin`` built from its ``<plugin>`` (and ``<sensor>``) element.
+
+A Gazebo plugin is one core module (a ``Plugin`` subclass that reads its tags, drives joints or senses, and
+computes its outputs, with no ROS), one ROS module (a subclass that adds the publishers and subscribers)
+and one line in ``plugins/registry.py``. The Simulation builds every plugin the same way, calls
+``update(now)`` when its timer is due and ``on_step`` after each physics step if it asks for it.
+"""
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Dict, Optional, Sequence, Tuple
+from xml.etree import ElementTree
+
+import numpy as np
+
+from .clock import UpdateTimer
+from .params import Param, PluginParams
+
+if TYPE_CHECKING:  # imported for the annotations only: the Simulation imports this module
+    from .simulation import Simulation, SpawnedModel
+
+
+@dataclass
+class PluginContext:
+    simulation: "Simulation"
+    model: "SpawnedModel"
+    link: Optional[str] = None  # a sensor plugin's link (the <gazebo reference>), lumped or not
+
+    @property
+    def engine(self):
+        return self.simulation.engine
+
+    @property
+    def robot(self):
+        return self.model.robot
+
+    def random_stream(self, key: str) -> np.random.Generator:
+        """This model's random stream named ``key`` (a sensor name): independent of other models and of spawn
+        order, and re-derived by reset_simulation."""
+        return self.simulation.random_stream(self.model.name, key)
+
+    def where(self, element: Optional[ElementTree.Element]) -> str:
+        """'model NAME:LINE' for messages about an element of the model's description."""
+        return self.model.robot.model.document.where(element)
+
+
+class Plugin:
+    """Base of every emulated plugin, model or sensor."""
+
+    # Gazebo's class name, for messages ("GazeboRosDiffDrive(ns = /): ..."); the Python class name if empty.
+    GAZEBO_CLASS = ""
+    PARAMS: Tuple[Param, ...] = ()
+    # Tags Gazebo reads without effect; accepted with one INFO line.
+    IGNORED_TAGS: Tuple[str, ...] = ()
+    # () for a model plugin; the <sensor type="..."> values a sensor plugin goes inside.
+    SENSOR_TYPES: Tuple[str, ...] = ()
+    # The enclosing <sensor>'s own values (SDF names and defaults) that a sensor plugin reads.
+    SENSOR_PARAMS: Tuple[Param, ...] = ()
+
+    timer: UpdateTimer  # set by every subclass
+    needs_every_step = False
+    driven_joints: Tuple[str, ...] = ()
+    joint_states_published: Tuple[str, ...] = ()
+
+    def __init__(self, context: PluginContext, element: ElementTree.Element,
+                 sensor: Optional[ElementTree.Element] = None):
+        self.context = context
+        self.element = element
+        self.sensor = sensor
+
+    @property
+    def label(self) -> str:
+        """How messages name the plugin, as gazebo_ros's own do: 'GazeboRosDiffDrive(ns = /)'."""
+        return f"{self.GAZEBO_CLASS or type(self).__name__}(ns = {self.namespace_tag() or self.context.model.name})"
+
+    def namespace_tag(self) -> Optional[str]:
+        element = self.element.find("robotNamespace")
+        return None if element is None else (element.text or "").strip()
+
+    def read_params(self, params: Sequence[Param] = None, element: ElementTree.Element = None,
+                    check_unknown: bool = True) -> Dict[str, Any]:
+        """The values of ``params`` (the class's PARAMS) in ``element`` (the <plugin>), or ConfigError."""
+        element = self.element if element is None else element
+        reader = PluginParams(element, self.label, self.IGNORED_TAGS, self.context.where(element), check_unknown)
+        return reader.read(self.PARAMS if params is None else params)
+
+    def on_step(self, step_size: float):
+        """After every physics step, when ``needs_every_step``."""
+
+    def update(self, now: float):
+        """When ``timer`` is due, with the sim time in seconds."""
+
+    def reset(self, now: float):
+        """World or simulation reset (Gazebo calls the plugin's Reset())."""
+        self.timer.reset(now)
+
+    def close(self):
+        """The model is deleted or the simulation stops."""

@@ -1,0 +1,248 @@
+"""The simulation, without ROS: the engine and world, the spawned models with their plugins, the update
+schedule, spawn/delete/reset in Gazebo's order, and the random streams of the noisy sensors.
+
+The ROS node runs ``advance`` in its loop and publishes /clock from the ``before_updates`` hook; the unit
+tests run the same ``advance`` with the plugins' core classes. Plugins are built from a registry
+(Gazebo file name -> class) handed in, so the core never imports the ROS plugin layer.
+"""
+import hashlib
+import logging
+from dataclasses import dataclass, field
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from xml.etree import ElementTree
+
+import numpy as np
+import pybullet
+
+from .engine import Engine, SpawnedRobot
+from .errors import ConfigError, ModelError
+from .geometry import IDENTITY, Pose
+from .log import get_logger, warn_once
+from .plugin import Plugin, PluginContext
+from .robot_model import RobotModel
+from .sdf_world import ModelDescription, WorldDescription
+from .viewer import Viewer
+from .world_bodies import load_world
+
+_logger = get_logger(__name__)
+
+# The bridge publishes the joint states no plugin publishes through this plugin, as a Gazebo user would add it.
+JOINT_STATE_PLUGIN = "libgazebo_ros_joint_state_publisher.so"
+# Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
+MAX_BATCH_SIM_SECONDS = 0.01
+
+# Called before the due plugins update: (sim time, whether any plugin is due). The node publishes /clock there.
+BeforeUpdates = Callable[[float, bool], None]
+
+
+@dataclass
+class SpawnedModel:
+    """A robot spawned from URDF, with the plugins built from its <gazebo> blocks."""
+    name: str
+    namespace: str
+    robot: SpawnedRobot
+    plugins: List[Plugin] = field(default_factory=list)
+
+
+class Simulation:
+    def __init__(self, world: WorldDescription, registry: Mapping[str, type], seed: int = 0,
+                 connection_mode: int = pybullet.DIRECT, joint_state_rate: float = 100.0):
+        self.engine = Engine(world.physics, connection_mode)
+        self.viewer = Viewer(self.engine) if connection_mode == pybullet.GUI else None
+        self.registry = registry
+        self.seed = seed
+        self.joint_state_rate = joint_state_rate
+        self.paused = False
+        self.models: Dict[str, SpawnedModel] = {}
+        # World models (from the .world and spawn_sdf_model) as described, by name.
+        self.world_models: Dict[str, ModelDescription] = {}
+        self._streams: Dict[str, Tuple[np.random.SeedSequence, np.random.Generator]] = {}
+        self._plugins: List[Plugin] = []
+        self._every_step: List[Plugin] = []
+        self.add_world(world)
+
+    # -- state -------------------------------------------------------------------------------------------------
+    @property
+    def sim_time(self) -> float:
+        return self.engine.sim_time
+
+    @property
+    def step_size(self) -> float:
+        return self.engine.physics.max_step_size
+
+    def model_names(self) -> List[str]:
+        return self.engine.model_names()
+
+    def random_stream(self, model_name: str, key: str) -> np.random.Generator:
+        """A generator seeded from the world seed and the stable key "model/key"; one per key."""
+        name = f"{model_name}/{key}"
+        if name not in self._streams:
+            # A hash of the name, not the spawn order or Python's salted hash(), keys the stream.
+            digest = hashlib.sha256(name.encode()).digest()
+            sequence = np.random.SeedSequence(self.seed, spawn_key=(int.from_bytes(digest[:8], "little"),))
+            self._streams[name] = (sequence, np.random.Generator(np.random.PCG64(sequence)))
+        return self._streams[name][1]
+
+    # -- spawn and delete ----------------------------------------------------------------------------------------
+    def add_world(self, description: WorldDescription) -> List[str]:
+        """Build the models of a world (the loaded one, or one spawn_sdf_model wraps); returns the names added."""
+        duplicates = [model.name for model in description.models if model.name in self.model_names()]
+        if duplicates:
+            raise ModelError("SpawnModel: Failure - entity already exists: %s" % ", ".join(duplicates))
+        loaded = load_world(self.engine.client, description)
+        self.engine.add_world(loaded)
+        for model in description.models:
+            if model.name in loaded.bodies:
+                self.world_models[model.name] = model
+        return list(loaded.bodies)
+
+    def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
+        """Put a parsed robot in the engine with its plugins; on any error, leave nothing of it behind."""
+        robot = self.engine.spawn_robot(model, name, pose, namespace, driven_joints=None)
+        spawned = SpawnedModel(name, namespace, robot)
+        try:
+            spawned.plugins = self._build_plugins(spawned)
+            self.engine.set_surfaces(robot, [joint for plugin in spawned.plugins for joint in plugin.driven_joints])
+        except BaseException:
+            for plugin in spawned.plugins:
+                plugin.close()
+            self.engine.remove(name)
+            raise
+        self.models[name] = spawned
+        self._schedule()
+        if self.viewer is not None:
+            self.viewer.show_robot(robot)
+        _logger.info("spawned '%s' (%d links, %d movable joints, %d plugins) at %s", name, len(robot.link_index),
+                     len(robot.movable_joints), len(spawned.plugins), tuple(round(v, 3) for v in pose.position))
+        return spawned
+
+    def delete(self, name: str):
+        if name not in self.model_names():
+            raise ModelError("DeleteModel: model '%s' does not exist" % name)
+        spawned = self.models.pop(name, None)
+        if spawned is not None:
+            for plugin in spawned.plugins:
+                plugin.close()
+            if self.viewer is not None:
+                self.viewer.forget_robot(spawned.robot)
+            for key in [key for key in self._streams if key.startswith(name + "/")]:
+                del self._streams[key]
+            self._schedule()
+        self.world_models.pop(name, None)
+        self.engine.remove(name)
+
+    def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
+        plugins: List[Plugin] = []
+        model = spawned.robot.model
+        for element in model.plugins:
+            plugins.extend(self._create_plugin(spawned, element, None, None))
+        for link_name, sensor in model.sensors():
+            elements = sensor.findall("plugin")
+            if not elements:
+                warn_once(_logger, "model '%s': sensor '%s' on link '%s' has no ROS plugin; nothing is published "
+                          "for it" % (spawned.name, sensor.get("name"), link_name))
+            for element in elements:
+                plugins.extend(self._create_plugin(spawned, element, sensor, link_name))
+        published = {joint for plugin in plugins for joint in plugin.joint_states_published}
+        remaining = [joint for joint in spawned.robot.movable_joints if joint not in published]
+        if remaining:
+            plugins.extend(self._create_plugin(spawned, self._joint_state_element(spawned, remaining), None, None))
+        return plugins
+
+    def _create_plugin(self, spawned: SpawnedModel, element: ElementTree.Element,
+                       sensor: Optional[ElementTree.Element], link_name: Optional[str]) -> List[Plugin]:
+        filename = element.get("filename", "")
+        plugin_class = self.registry.get(filename)
+        where = spawned.robot.model.document.where(element)
+        if plugin_class is None:
+            what = ("sensor '%s' (type %s) on link '%s': " % (sensor.get("name"), sensor.get("type"), link_name)
+                    if sensor is not None else "")
+            warn_once(_logger, "%s: model '%s': %splugin '%s' (%s) is not emulated by the bridge; ignored"
+                      % (where, spawned.name, what, element.get("name"), filename))
+            return []
+        if bool(plugin_class.SENSOR_TYPES) != (sensor is not None):
+            kind = "a sensor plugin (it goes inside a <sensor>)" if plugin_class.SENSOR_TYPES else "a model plugin"
+            warn_once(_logger, "%s: model '%s': %s is %s; ignored here, as Gazebo would not load it"
+                      % (where, spawned.name, filename, kind))
+            return []
+        if sensor is not None and sensor.get("type") not in plugin_class.SENSOR_TYPES:
+            raise ConfigError("%s: model '%s': %s needs <sensor type=\"%s\">, but sensor '%s' has type \"%s\""
+                              % (where, spawned.name, filename, "\" or \"".join(plugin_class.SENSOR_TYPES),
+                                 sensor.get("name"), sensor.get("type")))
+        context = PluginContext(self, spawned, link_name)
+        return [plugin_class(context, element, sensor)]
+
+    def _joint_state_element(self, spawned: SpawnedModel, joints: Sequence[str]) -> ElementTree.Element:
+        """The libgazebo_ros_joint_state_publisher.so block a Gazebo user would add for these joints."""
+        element = ElementTree.Element("plugin", name="bridge_joint_state_publisher", filename=JOINT_STATE_PLUGIN)
+        for tag, text in (("robotNamespace", spawned.namespace), ("jointName", ", ".join(joints)),
+                          ("updateRate", repr(self.joint_state_rate))):
+            ElementTree.SubElement(element, tag).text = text
+        return element
+
+    def _schedule(self):
+        self._plugins = [plugin for spawned in self.models.values() for plugin in spawned.plugins]
+        self._every_step = [plugin for plugin in self._plugins if plugin.needs_every_step]
+
+    # -- stepping ------------------------------------------------------------------------------------------------
+    def steps_to_next_event(self) -> int:
+        """Physics steps until the next plugin timer can be due (1 when a plugin needs every step)."""
+        if self._every_step:
+            return 1
+        now, step = self.sim_time, self.step_size
+        batch = max(1, int(round(MAX_BATCH_SIM_SECONDS / step)))
+        return min([batch] + [plugin.timer.steps_until_due(now, step) for plugin in self._plugins])
+
+    def advance(self, max_steps: int, before_updates: Optional[BeforeUpdates] = None) -> int:
+        """Step up to the next plugin event or ``max_steps``, then run the due updates; returns the steps taken."""
+        count = max(1, min(max_steps, self.steps_to_next_event()))
+        self.engine.step(count)
+        for plugin in self._every_step:
+            self._guarded(plugin, plugin.on_step, self.step_size)
+        now = self.sim_time
+        due = [plugin for plugin in self._plugins if plugin.timer.due(now)]
+        if before_updates is not None:
+            before_updates(now, bool(due))
+        for plugin in due:
+            self._guarded(plugin, plugin.update, now)
+        if self.viewer is not None:
+            self.viewer.follow()
+        return count
+
+    def step(self, count: int, before_updates: Optional[BeforeUpdates] = None):
+        """Exactly ``count`` physics steps, with every plugin event on the way."""
+        while count > 0:
+            count -= self.advance(count, before_updates)
+
+    def _guarded(self, plugin: Plugin, method, argument):
+        """A plugin that raises is logged once, closed and dropped; the simulation and other models go on."""
+        try:
+            method(argument)
+        except Exception:  # the plugin boundary: any failure inside one plugin must not stop the others
+            _logger.log(logging.ERROR, "model '%s': plugin %s failed and is disabled", plugin.context.model.name,
+                        plugin.label, exc_info=True)
+            plugin.context.model.plugins.remove(plugin)
+            try:
+                plugin.close()
+            except Exception:  # closing a broken plugin may fail too; it is gone either way
+                _logger.debug("closing %s failed", plugin.label, exc_info=True)
+            self._schedule()
+
+    # -- reset ---------------------------------------------------------------------------------------------------
+    def reset(self, simulation: bool):
+        """reset_simulation (sim time back to 0, random streams re-derived) or reset_world (models only)."""
+        if simulation:
+            self.engine.reset_simulation()
+            for sequence, generator in self._streams.values():
+                generator.bit_generator.state = np.random.PCG64(sequence).state
+        else:
+            self.engine.reset_world()
+        for plugin in list(self._plugins):
+            self._guarded(plugin, plugin.reset, self.sim_time)
+
+    def close(self):
+        for name in list(self.models):
+            for plugin in self.models.pop(name).plugins:
+                plugin.close()
+        self._schedule()
+        self.engine.close()

@@ -1,0 +1,24 @@
+"""``libgazebo_ros_joint_state_publisher.so``: sensor_msgs/JointState of the named joints."""
+from sensor_msgs.msg import JointState
+
+from ..core.joint_states import JointStatePublisher
+from . import loop_publisher, resolve_in_namespace, ros_time
+
+
+class GazeboRosJointStatePublisher(JointStatePublisher):
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        self.publisher = loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
+
+    def update(self, now: float):
+        message = JointState()
+        message.header.stamp = ros_time(now)
+        message.name = self.joint_names
+        states = self.states()
+        message.position = [state[0] for state in states]
+        message.velocity = [state[1] for state in states]
+        message.effort = [state[2] for state in states]
+        self.publisher.publish(message)
+
+    def close(self):
+        self.publisher.unregister()

@@ -1,0 +1,144 @@
+"""core/simulation.py: the seed robot spawned, commanded and stepped through the node's own loop code, with the
+plugins' core classes and no ROS master; per-sensor random streams; plugin failures contained."""
+import logging
+import math
+import os
+
+import numpy as np
+import pytest
+
+from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
+from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.lidar import RaySensor
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.simulation import Simulation
+
+WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds")
+# The core classes under the Gazebo file names, as plugins/registry.py maps the ROS classes.
+CORE_REGISTRY = {
+    "libgazebo_ros_diff_drive.so": DiffDrive,
+    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
+    "libgazebo_ros_laser.so": RaySensor,
+}
+
+
+def simulation(world="empty.world", seed=0):
+    return Simulation(parse_world(os.path.join(WORLDS, world)), CORE_REGISTRY, seed=seed)
+
+
+def plugin_of(spawned, plugin_class):
+    return next(plugin for plugin in spawned.plugins if isinstance(plugin, plugin_class))
+
+
+def test_spawn_command_step_and_read_odometry(mbot_urdf):
+    sim = simulation()
+    try:
+        spawned = sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot")
+        drive = plugin_of(spawned, DiffDrive)
+        assert drive.driven_joints == ("left_wheel_joint", "right_wheel_joint")
+        # The caster is the only movable joint the diff drive neither drives nor publishes.
+        assert plugin_of(spawned, JointStatePublisher).joint_names == ["back_caster_joint"]
+        assert drive.set_command(0.2, 0.0)
+        sim.step(3000)
+        (position, _), (vx, _), _ = drive.odometry()
+        assert sim.sim_time == pytest.approx(3.0)
+        assert vx == pytest.approx(0.2, rel=0.01)
+        assert position[0] == pytest.approx(0.2 * 3.0, abs=0.05)  # a short ramp at the start
+        assert not drive.set_command(math.nan, 0.0)
+        drive.set_command(0.0, 1.0)
+        sim.step(1000)
+        _, _, angular = drive.odometry()
+        assert angular == pytest.approx(1.0, rel=0.02)
+    finally:
+        sim.close()
+
+
+def test_reset_simulation_brings_back_time_pose_and_the_command(mbot_urdf):
+    sim = simulation()
+    try:
+        start = pose_from_xyz_rpy((1, 2, 0), (0, 0, 0.5))
+        spawned = sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot", start)
+        drive = plugin_of(spawned, DiffDrive)
+        drive.set_command(0.3, 0.2)
+        sim.step(1500)
+        sim.reset(simulation=True)
+        assert sim.sim_time == 0.0
+        (position, orientation), _, _ = drive.odometry()
+        assert position[:2] == pytest.approx((1.0, 2.0), abs=1e-6)
+        assert yaw(orientation) == pytest.approx(0.5, abs=1e-6)
+        sim.step(500)
+        (position, _), _, _ = drive.odometry()
+        assert position[:2] == pytest.approx((1.0, 2.0), abs=1e-3)  # the command was zeroed
+    finally:
+        sim.close()
+
+
+def _first_scan(urdf, names_in_order, measured, seed=7):
+    """The first scan of ``measured``'s lidar right after spawning ``names_in_order`` (others 50 m away,
+    out of the lidar's 6 m range), and the same scan after more scans and a reset_simulation."""
+    sim = simulation("playground.world", seed=seed)
+    try:
+        for name in names_in_order:
+            y = 0.0 if name == measured else 50.0 + len(sim.models)
+            sim.spawn_robot(parse_robot(urdf, "model '%s'" % name), name, pose_from_xyz_rpy((0, y, 0), (0, 0, 0)))
+        lidar = plugin_of(sim.models[measured], RaySensor)
+        first = lidar.scan().ranges
+        for _ in range(3):
+            sim.step(200)
+            lidar.scan()
+        sim.reset(simulation=True)
+        return first, lidar.scan().ranges
+    finally:
+        sim.close()
+
+
+def test_noise_of_one_robot_does_not_depend_on_other_robots_or_spawn_order(laser_mbot_urdf):
+    alone, _ = _first_scan(laser_mbot_urdf, ["a"], "a")
+    assert np.isfinite(alone).sum() > 100
+    assert np.array_equal(alone, _first_scan(laser_mbot_urdf, ["a", "b"], "a")[0])
+    assert np.array_equal(alone, _first_scan(laser_mbot_urdf, ["b", "a"], "a")[0])
+    assert np.array_equal(alone, _first_scan(laser_mbot_urdf, ["c", "b", "a"], "a")[0])
+    # Another seed, or another robot name at the same place, draws other noise.
+    assert not np.array_equal(alone, _first_scan(laser_mbot_urdf, ["a"], "a", seed=8)[0])
+    assert not np.array_equal(alone, _first_scan(laser_mbot_urdf, ["z"], "z")[0])
+
+
+def test_reset_simulation_rederives_the_random_streams(laser_mbot_urdf):
+    first, after_reset = _first_scan(laser_mbot_urdf, ["a", "b"], "a")
+    assert np.array_equal(first, after_reset)
+
+
+def test_a_failing_plugin_is_disabled_and_the_rest_runs(mbot_urdf, caplog):
+    sim = simulation()
+    try:
+        spawned = sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot")
+        drive = plugin_of(spawned, DiffDrive)
+        drive.update = lambda now: 1 / 0
+        with caplog.at_level(logging.ERROR):
+            sim.step(100)
+        assert drive not in spawned.plugins and len(spawned.plugins) == 1
+        assert "model 'mbot': plugin GazeboRosDiffDrive(ns = /) failed and is disabled" in caplog.text
+        sim.step(100)
+        assert sim.sim_time == pytest.approx(0.2)
+    finally:
+        sim.close()
+
+
+def test_a_bad_tag_refuses_the_spawn_and_leaves_nothing(mbot_urdf):
+    sim = simulation()
+    try:
+        bad = mbot_urdf.replace("<wheelDiameter>0.064</wheelDiameter>", "<wheelDiameter>0</wheelDiameter>")
+        assert bad != mbot_urdf
+        with pytest.raises(ConfigError) as error:
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        message = str(error.value)
+        assert message.startswith("model 'mbot':") and "GazeboRosDiffDrive" in message
+        assert "<wheelDiameter> has bad value '0': 0 is outside the valid range >= 0.001" in message
+        assert sim.model_names() == ["ground_plane"] and sim.models == {}
+        sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot")
+        assert "mbot" in sim.model_names()
+    finally:
+        sim.close()
