@@ -31,9 +31,9 @@ def test_database_include_gets_the_name_and_pose(tmp_path):
 
 @pytest.mark.parametrize("xml, message", [
     ("<robot name='r'/>", "is not SDF: its root element is <robot>"),
-    ("<sdf version='1.6'>", "is not valid XML"),
+    ("<sdf version='1.6'>", "not valid XML"),
     ("<sdf version='1.6'/>", "expected exactly one <model>"),
-    ("<sdf version='1.6'><model name='m'><pose>1 2</pose></model></sdf>", "<pose> must hold 6 numbers"),
+    ("<sdf version='1.6'><model name='m'><pose>1 2</pose></model></sdf>", "<pose> .x y z roll pitch yaw.: expected 6 numbers, got '1 2'"),
 ])
 def test_bad_sdf_models_are_refused_with_one_line(xml, message):
     with pytest.raises(ModelError, match=message):

@@ -7,24 +7,12 @@ composed with its own, as spawn_sdf_model does.
 from xml.etree import ElementTree
 
 from .errors import ModelError
-from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, rpy
+from .geometry import Pose, compose, rpy
+from .xml_values import parse_xml, read_pose
 
 
 def _pose_text(pose: Pose) -> str:
     return " ".join("%.9g" % value for value in tuple(pose.position) + tuple(rpy(pose.orientation)))
-
-
-def _element_pose(element: ElementTree.Element, where: str) -> Pose:
-    pose = element.find("pose")
-    if pose is None or not (pose.text or "").strip():
-        return IDENTITY
-    try:
-        values = [float(value) for value in pose.text.split()]
-    except ValueError:
-        values = []
-    if len(values) != 6:
-        raise ModelError("%s: <pose> must hold 6 numbers, got '%s'" % (where, pose.text.strip()))
-    return pose_from_xyz_rpy(values[:3], values[3:])
 
 
 def _set_pose(element: ElementTree.Element, pose: Pose):
@@ -36,10 +24,8 @@ def _set_pose(element: ElementTree.Element, pose: Pose):
 
 def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
     where = "model '%s'" % name
-    try:
-        root = ElementTree.fromstring(model_xml)
-    except ElementTree.ParseError as error:
-        raise ModelError("%s is not valid XML: %s" % (where, error)) from None
+    document = parse_xml(model_xml.encode(), where, ModelError)
+    root = document.root
     if root.tag != "sdf":
         raise ModelError("%s is not SDF: its root element is <%s>, not <sdf>" % (where, root.tag))
     world = root.find("world")
@@ -55,7 +41,7 @@ def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
         if name_element is None:
             name_element = ElementTree.SubElement(entry, "name")
         name_element.text = name
-    _set_pose(entry, compose(pose, _element_pose(entry, where)))
+    _set_pose(entry, compose(pose, read_pose(entry.find("pose"), document)))
     spawned = ElementTree.Element("sdf", version=root.get("version", "1.6"))
     ElementTree.SubElement(spawned, "world", name="spawn").append(entry)
     return ElementTree.tostring(spawned, encoding="unicode")

@@ -134,6 +134,8 @@ class ModelDescription:
     static: bool
     pose: Pose  # world frame
     links: Tuple[LinkDescription, ...]
+    # The world's <model> or <include> it was read from, so a saved world writes it back the same way.
+    source: Optional[ET.Element] = field(default=None, compare=False, repr=False)
 
     @property
     def shapes(self) -> Tuple[Shape, ...]:
@@ -146,6 +148,8 @@ class WorldDescription:
     path: str
     physics: PhysicsConfig
     models: Tuple[ModelDescription, ...]
+    # World children other than models, physics, gravity and frames (lights, scene, gui...), kept for saving.
+    others: Tuple[ET.Element, ...] = field(default=(), compare=False, repr=False)
 
     @property
     def shapes(self) -> Tuple[Shape, ...]:
@@ -182,11 +186,12 @@ class _ModelEntry(NamedTuple):
     pose_document: XmlDocument
     static: Optional[bool]
     where: str  # the <model> or <include> in the including file, for messages
+    source: ET.Element  # that <model> or <include>
 
 
 def _inline_model(element: ET.Element, document: XmlDocument) -> _ModelEntry:
     return _ModelEntry(element, document, element.get("name", ""), element.find("pose"), document, None,
-                       document.where(element))
+                       document.where(element), element)
 
 
 class _Frames:
@@ -243,18 +248,23 @@ class _WorldParser:
             raise WorldError(f"{path}: not an SDF world: no <sdf><world> element")
         self._check_version(document)
         scope = _Frames(f"world '{world.get('name', 'default')}'", IDENTITY, ("", "world"))
-        entries = []
+        entries, others = [], []
         for child in world:
             if child.tag == "model":
                 entries.append(_inline_model(child, document))
             elif child.tag == "include":
-                entries.extend(self._include(child, document))
+                included = self._include(child, document)
+                entries.extend(included)
+                if not included:  # a light such as model://sun, or a model not found here
+                    others.append(child)
             elif child.tag == "frame":
                 scope.add(child.get("name", ""), child.find("pose"), document, child.get("attached_to", ""))
             elif child.tag in _WORLD_UNSUPPORTED:
                 self._warn_unsupported(document, child)
             elif child.tag not in _WORLD_IGNORED:
                 self._warn_unknown(document, child, "world")
+            if child.tag not in ("model", "include", "frame", "physics", "gravity", "state"):
+                others.append(child)
         unique = {}
         for entry in entries:
             if entry.name in unique:
@@ -263,7 +273,8 @@ class _WorldParser:
             unique[entry.name] = entry
             scope.add(entry.name, entry.pose, entry.pose_document)
         models = tuple(self._model(entry, scope) for entry in unique.values())
-        return WorldDescription(world.get("name", "default"), path, self._physics(document, world), models)
+        return WorldDescription(world.get("name", "default"), path, self._physics(document, world), models,
+                                tuple(others))
 
     # Files ---------------------------------------------------------------------------------------------
 
@@ -361,7 +372,8 @@ class _WorldParser:
         return [_ModelEntry(model, model_document, read_text(include, "name") or model.get("name", ""),
                             pose if pose is not None else model.find("pose"),
                             document if pose is not None else model_document,
-                            None if static is None else read_bool(static, document), document.where(include))]
+                            None if static is None else read_bool(static, document), document.where(include),
+                            include)]
 
     def _model(self, entry: _ModelEntry, parent: _Frames) -> ModelDescription:
         static = entry.static
@@ -370,7 +382,7 @@ class _WorldParser:
         scope = _Frames(f"model '{entry.name}'", parent.frame(entry.name, entry.document, entry.element),
                         ("", "__model__"))
         links = self._links(entry, scope, static, entry.name, prefix="", expanding=(entry.element,))
-        return ModelDescription(entry.name, static, scope.origin, tuple(links))
+        return ModelDescription(entry.name, static, scope.origin, tuple(links), entry.source)
 
     def _links(self, entry: _ModelEntry, scope: _Frames, static: bool, model: str, prefix: str,
                expanding: Tuple[ET.Element, ...]) -> List[LinkDescription]:
