@@ -18,6 +18,7 @@ from geometry_msgs.msg import Pose as PoseMessage
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
+from .core.engine import check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .core.model_path import default_model_path
@@ -30,8 +31,10 @@ _WORLD_FRAMES = ("", "world", "map", "/map")
 
 
 def _pose_from_message(message: PoseMessage) -> Pose:
+    """The pose with its quaternion normalised, as gazebo_ros does; a zero quaternion is the identity."""
     q = message.orientation
     norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) ** 0.5
+    # A non-finite component stays non-finite here, and check_state refuses it by name.
     orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else (q.x / norm, q.y / norm, q.z / norm, q.w / norm)
     return Pose((message.position.x, message.position.y, message.position.z), orientation)
 
@@ -101,7 +104,9 @@ class GazeboRosApi:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
         if request.model_name in self.sim.model_names():
             raise ModelError("SpawnModel: Failure - entity already exists: %s" % request.model_name)
-        return compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+        pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+        check_state("SpawnModel: model '%s'" % request.model_name, pose)
+        return pose
 
     def _spawn_urdf_model(self, request):
         def spawn():

@@ -7,7 +7,7 @@ import pytest
 from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
 from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.errors import ModelError
-from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rpy, yaw
+from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy, rpy, yaw
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
@@ -119,3 +119,20 @@ def test_two_runs_with_the_same_inputs_are_identical(mbot_urdf):
         finally:
             drive.close()
     assert results[0] == results[1]
+
+
+@pytest.mark.parametrize("pose, linear, message", [
+    (Pose((float("nan"), 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), (0, 0, 0), "position.x is nan, not a finite number"),
+    (Pose((0.0, 0.0, 2e5), (0.0, 0.0, 0.0, 1.0)), (0, 0, 0), "position.z = 200000 is outside ±100000"),
+    (Pose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)), (0, float("inf"), 0), "linear velocity.y is inf"),
+])
+def test_a_state_that_bullet_cannot_hold_is_refused_and_changes_nothing(pose, linear, message):
+    engine = Engine()
+    try:
+        engine.add_world(load_world(engine.client, parse_world(EMPTY_WORLD)))
+        before = engine.model_pose("ground_plane")
+        with pytest.raises(ModelError, match=message.replace("(", r"\(").replace(")", r"\)")):
+            engine.set_model_state("ground_plane", pose, linear)
+        assert engine.model_pose("ground_plane") == before
+    finally:
+        engine.close()

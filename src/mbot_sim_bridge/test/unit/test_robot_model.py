@@ -1,4 +1,5 @@
 import logging
+import os
 
 import pytest
 
@@ -106,3 +107,36 @@ def test_bad_urdf_gives_one_line_errors(xml, message):
     with pytest.raises(ModelError) as error:
         parse_robot(xml)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def _mesh_robot(collision_mesh, visual_mesh):
+    return robot('<link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
+                 'ixz="0" iyz="0"/></inertial>'
+                 f'<visual><geometry><mesh filename="{visual_mesh}"/></geometry></visual>'
+                 f'<collision><geometry><mesh filename="{collision_mesh}"/></geometry></collision></link>')
+
+
+def test_a_missing_collision_mesh_names_file_link_and_model(tmp_path):
+    good = tmp_path / "good.stl"
+    good.write_text("solid x\nendsolid x\n")
+    with pytest.raises(ModelError) as error:
+        parse_robot(_mesh_robot(tmp_path / "missing.stl", good), "model 'probe'")
+    assert str(error.value) == (f"model 'probe': link 'base' collision mesh '{tmp_path}/missing.stl': "
+                                f"No such file or directory")
+
+
+def test_a_missing_visual_mesh_is_left_out_with_a_warning(tmp_path, caplog):
+    good = tmp_path / "good.stl"
+    good.write_text("solid x\nendsolid x\n")
+    with caplog.at_level(logging.WARNING):
+        model = parse_robot(_mesh_robot(good, f"file://{tmp_path}/gone.dae"), "model 'probe'")
+    assert "gone.dae" not in model.pybullet_urdf and "good.stl" in model.pybullet_urdf
+    assert (f"model 'probe': link 'base' visual mesh 'file://{tmp_path}/gone.dae': No such file or directory; "
+            f"the visual is left out") in caplog.text
+
+
+def test_a_mesh_that_is_not_a_regular_file_is_refused_unopened(tmp_path):
+    fifo = tmp_path / "pipe.stl"
+    os.mkfifo(fifo)
+    with pytest.raises(ModelError, match="collision mesh '.*pipe.stl': not a regular file"):
+        parse_robot(_mesh_robot(fifo, fifo), "model 'probe'")

@@ -33,7 +33,8 @@ def test_database_include_gets_the_name_and_pose(tmp_path):
     ("<robot name='r'/>", "is not SDF: its root element is <robot>"),
     ("<sdf version='1.6'>", "not valid XML"),
     ("<sdf version='1.6'/>", "expected exactly one <model>"),
-    ("<sdf version='1.6'><model name='m'><pose>1 2</pose></model></sdf>", "<pose> .x y z roll pitch yaw.: expected 6 numbers, got '1 2'"),
+    ("<sdf version='1.6'><model name='m'><pose>1 2</pose></model></sdf>",
+     "<pose> .x y z roll pitch yaw.: expected 6 numbers, got '1 2'"),
 ])
 def test_bad_sdf_models_are_refused_with_one_line(xml, message):
     with pytest.raises(ModelError, match=message):

@@ -4,6 +4,7 @@ Each Engine owns its own BulletClient (never PyBullet's module-global client), s
 side by side. Sim time is kept as a whole number of physics steps, so it never drifts.
 """
 import contextlib
+import math
 import os
 import sys
 import tempfile
@@ -23,6 +24,10 @@ from .xml_values import check_range, parse_float
 
 _logger = get_logger(__name__)
 
+# Beyond these a body is lost to the simulation (Bullet's broadphase and solver overflow or lose all precision),
+# so poses and velocities given from outside are refused past them.
+MAX_POSITION = 1.0e5  # m
+MAX_SPEED = 1.0e4  # m/s and rad/s
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
 # Collision-filter group bits handed to spawned robots, one bit each, so a robot's own sensors can skip it.
@@ -75,6 +80,17 @@ def frame_velocity(client: BulletClient, body: int, frame_position) -> Tuple[Tup
     com, _ = client.getBasePositionAndOrientation(body)
     linear, angular = client.getBaseVelocity(body)
     return _point_velocity(com, linear, angular, frame_position)
+
+
+def check_state(what: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
+    """ModelError naming the field when a requested pose or twist is not finite or beyond what Bullet can hold."""
+    for name, values, limit in (("position", pose.position, MAX_POSITION), ("orientation", pose.orientation, 1.0),
+                                ("linear velocity", linear, MAX_SPEED), ("angular velocity", angular, MAX_SPEED)):
+        for axis, value in zip("xyzw", values):
+            if not math.isfinite(value):
+                raise ModelError(f"{what}: {name}.{axis} is {value}, not a finite number; nothing was changed")
+            if abs(value) > limit * (1.0 + 1e-9):
+                raise ModelError(f"{what}: {name}.{axis} = {value:g} is outside ±{limit:g}; nothing was changed")
 
 
 def _friction(text: str, model: str, link: str) -> float:
@@ -201,6 +217,7 @@ class Engine:
         """
         if name in self.robots or name in self.world_bodies:
             raise ModelError("model '%s' already exists" % name)
+        check_state(f"SpawnModel: model '{name}'", pose)
         body = self._load_urdf(model, pose)
         robot = SpawnedRobot(self.client, name, model, body, namespace, self._free_collision_group())
         for index in robot.link_index.values():
@@ -244,6 +261,7 @@ class Engine:
     def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
         """Move a model's frame to ``pose`` and give every link the same world velocity (as Gazebo does)."""
         body = self.body_of(name)
+        check_state(f"SetModelState: model '{name}'", pose, linear, angular)
         com = compose(pose, inverse(self._root_from_com[body]))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)

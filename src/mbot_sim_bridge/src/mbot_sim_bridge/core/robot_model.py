@@ -10,6 +10,8 @@ Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
 """
 import copy
 import math
+import os
+import stat
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 from xml.etree import ElementTree
@@ -188,7 +190,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     dropped = _drop_massless_moving_links(links, joints, source)
     lumped_into = _lump_fixed_links(roots[0], links, joints)
     return RobotModel(name, roots[0], links, joints, plugins, lumped_into,
-                      _pybullet_urdf(root, links, dropped), transmissions, document)
+                      _pybullet_urdf(root, links, dropped, source), transmissions, document)
 
 
 def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:
@@ -270,9 +272,49 @@ def _lump_fixed_links(root_name, links, joints) -> Dict[str, Tuple[str, Pose]]:
     return lumped
 
 
-def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str]) -> str:
-    """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless."""
+def _mesh_problem(filename: str) -> Optional[str]:
+    """Why PyBullet could not read a URDF mesh file, or None. Nothing is opened: a FIFO would block the loader."""
+    path = filename[len("file://"):] if filename.startswith("file://") else filename
+    if "://" in path:
+        return "only absolute paths, file:// and package:// (resolved by spawn_urdf_model) can be read"
+    if not os.path.isabs(path):
+        return "a relative path has nothing to be relative to in robot_description; use package:// or an absolute path"
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as error:
+        return error.strerror or str(error)
+    if not stat.S_ISREG(mode):
+        return "not a regular file"
+    if not os.access(path, os.R_OK):
+        return "not readable"
+    return None
+
+
+def _check_meshes(root: ElementTree.Element, source: str):
+    """A collision mesh that cannot be read refuses the model; a visual one is left out with a warning (the
+    simulation does not need it, and PyBullet would refuse the whole URDF for it)."""
+    for link in root.findall("link"):
+        for kind in ("collision", "visual"):
+            for element in link.findall(kind):
+                mesh = element.find("geometry/mesh")
+                if mesh is None:
+                    continue
+                problem = _mesh_problem(mesh.get("filename", ""))
+                if problem is None:
+                    continue
+                message = "%s: link '%s' %s mesh '%s': %s" % (
+                    source, link.get("name"), kind, mesh.get("filename", ""), problem)
+                if kind == "collision":
+                    raise ModelError(message)
+                warn_once(_logger, message + "; the visual is left out")
+                link.remove(element)
+
+
+def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], source: str) -> str:
+    """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless,
+    meshes checked."""
     root = copy.deepcopy(root)
+    _check_meshes(root, source)
     for element in list(root):
         if element.tag in ("gazebo", "transmission"):
             root.remove(element)

@@ -37,6 +37,7 @@ _BUILTIN_MODELS = {
         </collision></link></model></sdf>""",
     "sun": """<sdf version="1.6"><light type="directional" name="sun"/></sdf>""",
 }
+BUILTIN_MODEL_NAMES = tuple(_BUILTIN_MODELS)
 
 # Children read elsewhere or without effect on contacts pass silently; unsupported and unknown ones warn once.
 _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "gui", "physics", "scene", "light",
