@@ -95,8 +95,11 @@ def test_spawn_pose_and_reset_world(core_drive, mbot_urdf):
     engine.reset_world()
     assert core_drive.robot.root_pose().position == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
     assert engine.sim_time == pytest.approx(1.5)
-    engine.reset_simulation()
-    assert engine.sim_time == 0.0
+    engine.restart()
+    assert engine.sim_time == 0.0 and engine.model_names() == []
+    engine.respawn(other)
+    assert engine.model_names() == ["second"]
+    assert other.root_pose().position == pytest.approx((2.0, 1.0, 0.0), abs=1e-6)
 
 
 def test_duplicate_and_unknown_model_names_are_errors(core_drive, mbot_urdf):

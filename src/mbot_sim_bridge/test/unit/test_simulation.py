@@ -142,3 +142,39 @@ def test_a_bad_tag_refuses_the_spawn_and_leaves_nothing(mbot_urdf):
         assert "mbot" in sim.model_names()
     finally:
         sim.close()
+
+
+def _drive_and_record(sim, drive, commands):
+    """Odometry after each (command, steps) of a script: the core of a lockstep test."""
+    record = []
+    for linear, angular, steps in commands:
+        drive.set_command(linear, angular)
+        sim.step(steps)
+        record.append(drive.odometry())
+    return record
+
+
+def test_reset_simulation_repeats_a_run_bit_for_bit(mbot_urdf, laser_mbot_urdf):
+    script = [(0.3, 0.0, 700), (0.2, 0.8, 900), (-0.1, -0.5, 600), (0.0, 0.0, 300)]
+    sim = simulation("playground.world", seed=3)
+    try:
+        sim.spawn_robot(parse_robot(mbot_urdf, "model 'plain'"), "plain", pose_from_xyz_rpy((1, -1, 0), (0, 0, 0)))
+        spawned = sim.spawn_robot(parse_robot(laser_mbot_urdf, "model 'lidar'"), "lidar")
+        drive, lidar = plugin_of(spawned, DiffDrive), plugin_of(spawned, RaySensor)
+        first = _drive_and_record(sim, drive, script), lidar.scan().ranges
+        sim.reset(simulation=True)
+        again = _drive_and_record(sim, drive, script), lidar.scan().ranges
+        assert first[0] == again[0]
+        assert np.array_equal(first[1], again[1])
+        other = simulation("playground.world", seed=3)
+        try:
+            other.spawn_robot(parse_robot(mbot_urdf, "model 'plain'"), "plain",
+                              pose_from_xyz_rpy((1, -1, 0), (0, 0, 0)))
+            twin = other.spawn_robot(parse_robot(laser_mbot_urdf, "model 'lidar'"), "lidar")
+            fresh = (_drive_and_record(other, plugin_of(twin, DiffDrive), script),
+                     plugin_of(twin, RaySensor).scan().ranges)
+            assert fresh[0] == first[0] and np.array_equal(fresh[1], first[1])
+        finally:
+            other.close()
+    finally:
+        sim.close()

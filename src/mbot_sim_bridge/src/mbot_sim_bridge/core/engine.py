@@ -106,13 +106,15 @@ class SpawnedRobot:
     """A URDF robot in the engine, addressed by URDF link and joint names."""
 
     def __init__(self, client: BulletClient, name: str, model: RobotModel, body: int, namespace: str,
-                 collision_group: int):
+                 collision_group: int, spawn_pose: Pose = IDENTITY):
         self.client = client
         self.name = name
         self.model = model
         self.body = body
         self.namespace = namespace
         self.collision_group = collision_group
+        self.spawn_pose = spawn_pose
+        self.driven_joints: Tuple[str, ...] = ()
         self.link_index: Dict[str, int] = {model.root: -1}
         self.joint_index: Dict[str, int] = {}
         for index in range(client.getNumJoints(body)):
@@ -178,16 +180,33 @@ class Engine:
     def __init__(self, physics: PhysicsConfig = PhysicsConfig(), connection_mode: int = pybullet.DIRECT):
         self.client = BulletClient(connection_mode=connection_mode)
         self.physics = physics
-        self.client.setTimeStep(physics.max_step_size)
-        self.client.setGravity(*physics.gravity)
-        # Same inputs, same contacts: keeps two runs (and two tests) identical.
-        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        self._configure()
         self.steps = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
+
+    def _configure(self):
+        self.client.setTimeStep(self.physics.max_step_size)
+        self.client.setGravity(*self.physics.gravity)
+        # Same inputs, same contacts: keeps two runs (and two tests) identical.
+        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+
+    def restart(self):
+        """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
+
+        reset_simulation goes through here rather than restoring poses: Bullet keeps contact caches and
+        solver warm-start state that a restore does not reset, so only a rebuild repeats a run bit for bit.
+        """
+        self.client.resetSimulation()
+        self._configure()
+        self.steps = 0
+        self.robots.clear()
+        self.world_bodies.clear()
+        self._initial.clear()
+        self._root_from_com.clear()
 
     @property
     def sim_time(self) -> float:
@@ -218,18 +237,26 @@ class Engine:
         if name in self.robots or name in self.world_bodies:
             raise ModelError("model '%s' already exists" % name)
         check_state(f"SpawnModel: model '{name}'", pose)
-        body = self._load_urdf(model, pose)
-        robot = SpawnedRobot(self.client, name, model, body, namespace, self._free_collision_group())
+        robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace,
+                             self._free_collision_group(), pose)
+        self._place(robot, driven_joints)
+        return robot
+
+    def respawn(self, robot: SpawnedRobot):
+        """Load ``robot`` again at its spawn pose after ``restart``; the same object gets the new body."""
+        robot.body = self._load_urdf(robot.model, robot.spawn_pose)
+        self._place(robot, robot.driven_joints)
+
+    def _place(self, robot: SpawnedRobot, driven_joints: Optional[Sequence[str]]):
         for index in robot.link_index.values():
-            self.client.setCollisionFilterGroupMask(body, index, robot.collision_group, -1)
+            self.client.setCollisionFilterGroupMask(robot.body, index, robot.collision_group, -1)
         if driven_joints is not None:
             self.set_surfaces(robot, driven_joints)
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
-        self.robots[name] = robot
-        self._root_from_com[body] = robot.root_from_com
-        self._remember_initial_state(body)
-        return robot
+        self.robots[robot.name] = robot
+        self._root_from_com[robot.body] = robot.root_from_com
+        self._remember_initial_state(robot.body)
 
     def remove(self, name: str):
         if name in self.robots:
@@ -274,11 +301,6 @@ class Engine:
             for index, position in initial.joint_positions.items():
                 self.client.resetJointState(body, index, position, 0.0)
 
-    def reset_simulation(self):
-        """reset_world plus sim time back to 0 (Gazebo's reset_simulation)."""
-        self.reset_world()
-        self.steps = 0
-
     def close(self):
         if self.client is not None:
             self.client.disconnect()
@@ -304,6 +326,7 @@ class Engine:
 
     def set_surfaces(self, robot: SpawnedRobot, driven_joints: Sequence[str]):
         """Friction of every link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
+        robot.driven_joints = tuple(driven_joints)
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
             _logger.info("%s: ball-caster contact (frictionless) for %s", robot.name, ", ".join(sorted(casters)))

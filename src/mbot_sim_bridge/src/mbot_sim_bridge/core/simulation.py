@@ -7,7 +7,7 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 """
 import hashlib
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 from xml.etree import ElementTree
 
@@ -57,6 +57,8 @@ class Simulation:
         # World models (from the .world and spawn_sdf_model) as described, by name.
         self.world_models: Dict[str, ModelDescription] = {}
         self._streams: Dict[str, Tuple[np.random.SeedSequence, np.random.Generator]] = {}
+        # What was built, in order (a WorldDescription, or the name of a robot), for reset_simulation's rebuild.
+        self._build_order: List[object] = []
         self._plugins: List[Plugin] = []
         self._every_step: List[Plugin] = []
         self.add_world(world)
@@ -94,6 +96,7 @@ class Simulation:
         for model in description.models:
             if model.name in loaded.bodies:
                 self.world_models[model.name] = model
+        self._build_order.append(description)
         return list(loaded.bodies)
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
@@ -109,6 +112,7 @@ class Simulation:
             self.engine.remove(name)
             raise
         self.models[name] = spawned
+        self._build_order.append(name)
         self._schedule()
         if self.viewer is not None:
             self.viewer.show_robot(robot)
@@ -127,6 +131,7 @@ class Simulation:
                 self.viewer.forget_robot(spawned.robot)
             for key in [key for key in self._streams if key.startswith(name + "/")]:
                 del self._streams[key]
+            self._build_order.remove(name)
             self._schedule()
         self.world_models.pop(name, None)
         self.engine.remove(name)
@@ -230,15 +235,28 @@ class Simulation:
 
     # -- reset ---------------------------------------------------------------------------------------------------
     def reset(self, simulation: bool):
-        """reset_simulation (sim time back to 0, random streams re-derived) or reset_world (models only)."""
+        """reset_simulation (sim time back to 0, the world rebuilt, random streams re-derived) or reset_world
+        (models back to their spawn state; sim time runs on)."""
         if simulation:
-            self.engine.reset_simulation()
+            self._rebuild()
             for sequence, generator in self._streams.values():
                 generator.bit_generator.state = np.random.PCG64(sequence).state
         else:
             self.engine.reset_world()
         for plugin in list(self._plugins):
             self._guarded(plugin, plugin.reset, self.sim_time)
+
+    def _rebuild(self):
+        """Every model built again in its original order, as a new run would: see Engine.restart."""
+        self.engine.restart()
+        for entry in self._build_order:
+            if isinstance(entry, str):
+                self.engine.respawn(self.models[entry].robot)
+                if self.viewer is not None:
+                    self.viewer.show_robot(self.models[entry].robot)
+            else:
+                kept = tuple(model for model in entry.models if model.name in self.world_models)
+                self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
 
     def close(self):
         for name in list(self.models):
