@@ -11,7 +11,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from .errors import ModelError
 from .xml_values import read_regular_file
@@ -56,6 +55,7 @@ def _welded(corners: np.ndarray) -> TriangleMesh:
 
 
 def _read_with_trimesh(path: str) -> np.ndarray:
+    import trimesh  # here, not at the top: importing it costs the node's start-up about a second
     # process=False keeps the file's triangles as they are; _welded merges the duplicate corners.
     mesh = trimesh.load(path, force="mesh", process=False)
     if not isinstance(mesh, trimesh.Trimesh):

@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 from typing import List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from .errors import ModelError, WorldError
 from .geometry import IDENTITY, Pose, compose, rotation_matrix
@@ -165,6 +164,7 @@ def parse_world(path: str, model_path: Optional[Sequence[str]] = None) -> WorldD
 
 def _convex_hull_2d(points: np.ndarray) -> Tuple[Tuple[float, float], ...]:
     """Counter-clockwise convex polygon of 2-D points, no repeated first point (scipy's Qhull)."""
+    from scipy.spatial import ConvexHull, QhullError  # only the map tools need it; it costs start-up 0.5 s
     # Micrometres: below that, PyBullet's single-precision transforms make straight edges look bent.
     unique = np.unique(np.round(points, 6) + 0.0, axis=0)
     if len(unique) < 3:

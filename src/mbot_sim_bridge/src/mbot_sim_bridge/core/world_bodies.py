@@ -9,7 +9,6 @@ from typing import Dict, Optional, Tuple
 
 import numpy as np
 import pybullet
-from scipy.spatial.transform import Rotation
 
 from .geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
 from .log import get_logger, warn_once
@@ -131,6 +130,7 @@ def _mass_properties(model: ModelDescription) -> Tuple[float, Pose, Optional[Tup
         local = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
         # Rotate into the model frame, then move to the common centre (parallel-axis theorem).
         inertia += rotation @ local @ rotation.T + link.mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+    from scipy.spatial.transform import Rotation  # only dynamic SDF models need it; it costs start-up 0.5 s
     moments, axes = np.linalg.eigh(inertia)
     if np.linalg.det(axes) < 0.0:
         axes[:, 2] = -axes[:, 2]
