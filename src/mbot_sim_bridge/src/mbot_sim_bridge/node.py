@@ -48,6 +48,8 @@ class SimBridgeNode:
         # Every ~param is read here, once (teleop_twist_keyboard style), and logged once below.
         self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
         paused = _bool_param("~paused", False)
+        # Lockstep: start paused; the simulation advances only through ~step_simulation.
+        lockstep = _bool_param("~lockstep", False)
         requested_gui = _bool_param("~gui", False)
         headless = _bool_param("~headless", False)
         real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
@@ -63,7 +65,7 @@ class SimBridgeNode:
             rospy.loginfo("gui:=true, but %s: running without a window"
                           % ("headless:=true" if headless else "no DISPLAY is set"))
         self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate)
-        self.sim.paused = paused
+        self.sim.paused = paused or lockstep
         physics = world.physics
         self.step_size = physics.max_step_size
         self.real_time_factor = (float(real_time_factor) if real_time_factor
@@ -74,6 +76,7 @@ class SimBridgeNode:
         self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
         self._requests: "queue.Queue[tuple]" = queue.Queue()
         self._pace_wall_start = self._pace_sim_start = 0.0
+        self._last_clock = -1.0
         # gazebo_ros sets /use_sim_time only when nobody has.
         if not rospy.has_param("/use_sim_time"):
             rospy.set_param("/use_sim_time", True)
@@ -81,7 +84,7 @@ class SimBridgeNode:
                       self.world_path, physics.max_step_size, physics.gravity,
                       self.real_time_factor or "0 (as fast as possible)",
                       "every step" if clock_frequency <= 0 else "at %.0f Hz" % clock_frequency,
-                      "paused" if paused else "running", "GUI" if gui else "headless")
+                      "lockstep" if lockstep else "paused" if paused else "running", "GUI" if gui else "headless")
         # Last: its services take calls at once, from other threads, and those use everything above.
         self.api = GazeboRosApi(self)
 
@@ -102,6 +105,15 @@ class SimBridgeNode:
         self.sim.reset(simulation)
         if simulation:
             self.clock_timer.reset(0.0)
+            self._last_clock = -1.0
+        self._restart_pacing()
+
+    def step(self, count: int):
+        """Exactly ``count`` physics steps, outputs and /clock included (lockstep); /clock ends at the last step,
+        so the nodes' ROS time is the sim time the answer reports."""
+        self.sim.step(count, self._before_updates)
+        if self._last_clock < self.sim.sim_time:
+            self._publish_clock(self.sim.sim_time)
         self._restart_pacing()
 
     def run(self, stop: threading.Event):
@@ -117,10 +129,14 @@ class SimBridgeNode:
     def _before_updates(self, now: float, plugins_due: bool):
         # /clock goes first, so no message is stamped ahead of the clock its subscribers have seen.
         if self.clock_timer.due(now) or plugins_due:
-            self.clock_publisher.publish(Clock(clock=ros_time(now)))
-            self.api.publish_model_states()
-            # The timer guarantees the longest gap between two /clock messages, counted from the last one.
-            self.clock_timer.reset(now)
+            self._publish_clock(now)
+
+    def _publish_clock(self, now: float):
+        self.clock_publisher.publish(Clock(clock=ros_time(now)))
+        self.api.publish_model_states()
+        # The timer guarantees the longest gap between two /clock messages, counted from the last one.
+        self.clock_timer.reset(now)
+        self._last_clock = now
 
     def _serve_requests(self, block: bool):
         try:

@@ -15,6 +15,7 @@ from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, Ge
                              GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
                              SpawnModelResponse)
 from geometry_msgs.msg import Pose as PoseMessage
+from mbot_sim_msgs.srv import StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
@@ -26,8 +27,11 @@ from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
 from .core.sdf_world import parse_world
 from .plugins import loop_publisher, ros_time
+from .subscriptions import drain
 
 _WORLD_FRAMES = ("", "world", "map", "/map")
+# How long a step request waits for the bridge's subscribers to handle what reached them.
+LOCKSTEP_DRAIN_SECONDS = 5.0
 
 
 def _pose_from_message(message: PoseMessage) -> Pose:
@@ -83,6 +87,7 @@ class GazeboRosApi:
             rospy.Service("~unpause_physics", Empty, self._empty(lambda: node.set_paused(False))),
             rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
             rospy.Service("~reset_world", Empty, self._empty(lambda: node.reset(simulation=False))),
+            rospy.Service("~step_simulation", StepSimulation, self._step_simulation),
         ]
 
     def _empty(self, action):
@@ -142,6 +147,23 @@ class GazeboRosApi:
             self.sim.delete(request.model_name)
             return DeleteModelResponse(success=True, status_message="DeleteModel: successfully deleted model")
         return self._guarded(DeleteModelResponse, delete)
+
+    # -- lockstep --------------------------------------------------------------------------------------------
+    def _step_simulation(self, request):
+        """The bridge's own: exactly ``steps`` physics steps of the paused simulation, after the messages that
+        reached the bridge before the request (see subscriptions.drain)."""
+        if not drain(timeout=LOCKSTEP_DRAIN_SECONDS):
+            rospy.logwarn("step_simulation: subscribers still busy after %.0f s; stepping anyway",
+                          LOCKSTEP_DRAIN_SECONDS)
+
+        def step():
+            if not self.sim.paused:
+                raise ModelError("StepSimulation: the simulation is running; pause it (or start with "
+                                 "lockstep:=true) to step it")
+            self.node.step(request.steps)
+            return StepSimulationResponse(success=True, sim_time=self.sim.sim_time,
+                                          status_message="StepSimulation: %d steps done" % request.steps)
+        return self._guarded(StepSimulationResponse, step)
 
     # -- state queries ---------------------------------------------------------------------------------------
     def _reference_pose(self, frame: str) -> Pose:

@@ -6,6 +6,7 @@ from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
 from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
+from ..subscriptions import TrackedSubscriber
 from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time
 
 
@@ -23,7 +24,7 @@ class GazeboRosDiffDrive(DiffDrive):
         self.joint_state_publisher = (loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
                                       if self.joint_states_published else None)
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
-        self.subscriber = rospy.Subscriber(self.command_topic, Twist, self._on_command, queue_size=1)
+        self.subscriber = TrackedSubscriber(self.command_topic, Twist, self._on_command)
         if params["publishWheelTF"]:
             rospy.loginfo("%s: publishWheelTF: the wheel frames reach /tf through robot_state_publisher from "
                           "joint_states; they are not broadcast a second time (that duplicate is what makes "
@@ -64,7 +65,8 @@ class GazeboRosDiffDrive(DiffDrive):
         self.odom_publisher.publish(odometry)
         if self.tf_publisher is not None:
             transform = TransformStamped()
-            transform.header = odometry.header
+            # Not the odometry's header object: rospy wrote its publisher's counter into that one's seq.
+            transform.header.stamp, transform.header.frame_id = stamp, self.odom_frame
             transform.child_frame_id = self.base_frame
             translation = transform.transform.translation
             translation.x, translation.y, translation.z = position

@@ -1,0 +1,105 @@
+"""A test's handle on a bridge running in lockstep (``lockstep:=true``): command, step, read.
+
+    from mbot_sim_bridge.lockstep import LockstepClient
+    sim = LockstepClient()                              # waits for /gazebo/step_simulation
+    cmd_vel = sim.publisher("/cmd_vel", Twist)          # synchronous; waits until the bridge subscribes
+    odom = sim.recorder(["/odom"])                      # raw bytes per (topic, publisher), in arrival order
+    cmd_vel.publish(Twist(linear=Vector3(x=0.2)))
+    sim.step(500)                                       # the command is applied before the first step
+    sim.settle()                                        # every message of those steps has been received
+    odom.messages("/odom", "/gazebo")[-1]
+
+The bridge applies what reached it before a step request first (see ``subscriptions``); publishers made here
+are synchronous, so a ``publish`` has reached the bridge by the time it returns.
+"""
+import threading
+import time
+import warnings
+from collections import defaultdict
+from typing import Dict, List, Tuple
+
+import rospy
+from mbot_sim_msgs.srv import StepSimulation
+
+from .subscriptions import TrackedSubscriber, drain
+
+
+class Recorder:
+    """The serialized messages of some topics, per (topic, publishing node), in the order they arrived."""
+
+    def __init__(self, topics: List[str]):
+        self._lock = threading.Lock()
+        self._messages: Dict[Tuple[str, str], List[bytes]] = defaultdict(list)
+        self.subscribers = [TrackedSubscriber(topic, rospy.AnyMsg, self._receiver(topic), queue_size=None)
+                            for topic in topics]
+
+    def _receiver(self, topic):
+        def receive(message):
+            with self._lock:
+                self._messages[(topic, message._connection_header["callerid"])].append(bytes(message._buff))
+        return receive
+
+    def messages(self, topic: str = None, publisher: str = None) -> Dict[Tuple[str, str], List[bytes]]:
+        """A copy of what arrived, optionally only one topic and/or publishing node."""
+        with self._lock:
+            return {key: list(values) for key, values in self._messages.items()
+                    if (topic is None or key[0] == topic) and (publisher is None or key[1] == publisher)}
+
+    def clear(self):
+        with self._lock:
+            self._messages.clear()
+
+    def close(self):
+        for subscriber in self.subscribers:
+            subscriber.unregister()
+
+
+class LockstepClient:
+    def __init__(self, gazebo_namespace: str = "/gazebo", timeout: float = 60.0):
+        self.timeout = timeout
+        service = gazebo_namespace + "/step_simulation"
+        rospy.wait_for_service(service, timeout=timeout)
+        self._step = rospy.ServiceProxy(service, StepSimulation, persistent=True)
+        self._recorders: List[Recorder] = []
+
+    def publisher(self, topic: str, message_type, subscribers: int = 1) -> rospy.Publisher:
+        """A synchronous publisher, returned once ``subscribers`` nodes (the bridge) are connected to it."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SyntaxWarning)  # rospy's note about queue_size=None: chosen here
+            publisher = rospy.Publisher(topic, message_type, queue_size=None)
+        self._wait(lambda: publisher.get_num_connections() >= subscribers, "%s to be subscribed" % topic)
+        return publisher
+
+    def recorder(self, topics: List[str], publishers: Dict[str, int] = None) -> Recorder:
+        """Start recording ``topics``; returns once each has its number of ``publishers`` (default 1) connected."""
+        recorder = Recorder(topics)
+        for topic, subscriber in zip(topics, recorder.subscribers):
+            wanted = (publishers or {}).get(topic, 1)
+            self._wait(lambda: subscriber.subscriber.get_num_connections() >= wanted,
+                       "%s to have %d publishers" % (topic, wanted))
+        self._recorders.append(recorder)
+        return recorder
+
+    def step(self, steps: int) -> float:
+        """Advance exactly ``steps`` physics steps; returns the sim time after them."""
+        response = self._step(steps)
+        if not response.success:
+            raise RuntimeError(response.status_message)
+        return response.sim_time
+
+    def settle(self):
+        """Wait until every recorder has handled all the bridge sent before now."""
+        if not drain([s for recorder in self._recorders for s in recorder.subscribers], timeout=self.timeout):
+            raise RuntimeError("recorded topics still busy after %.0f s" % self.timeout)
+
+    def close(self):
+        for recorder in self._recorders:
+            recorder.close()
+        self._step.close()
+
+    def _wait(self, condition, what: str):
+        deadline = time.monotonic() + self.timeout
+        while not condition():
+            if time.monotonic() > deadline:
+                raise RuntimeError("timed out after %.0f s waiting for %s" % (self.timeout, what))
+            time.sleep(0.01)
