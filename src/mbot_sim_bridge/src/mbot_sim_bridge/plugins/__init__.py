@@ -34,9 +34,23 @@ def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
     return rospy.names.ns_join(namespace or "/", name)
 
 
-def resolve_frame(frame: str) -> str:
-    """tf::resolve with an empty tf_prefix: a leading '/' is stripped."""
-    return frame.lstrip("/")
+def tf_prefix(namespace: Optional[str]) -> str:
+    """tf::getPrefixParam as a plugin's NodeHandle in ``namespace`` does it: the nearest ``tf_prefix`` parameter
+    searched upwards from the namespace (how multi-robot launch files keep robots' frames apart), or ""."""
+    parts = [part for part in (namespace or "/").split("/") if part]
+    for depth in range(len(parts), -1, -1):
+        name = "/" + "/".join(parts[:depth] + ["tf_prefix"])
+        if rospy.has_param(name):
+            return str(rospy.get_param(name))
+    return ""
+
+
+def resolve_frame(frame: str, prefix: str = "") -> str:
+    """tf::resolve: an absolute frame loses its '/' and keeps no prefix; a relative one gets "prefix/"."""
+    if frame.startswith("/"):
+        return frame.lstrip("/")
+    prefix = prefix.strip("/")
+    return "%s/%s" % (prefix, frame) if prefix else frame
 
 
 def sensor_namespace(plugin) -> str:

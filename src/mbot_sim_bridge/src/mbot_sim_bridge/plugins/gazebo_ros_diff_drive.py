@@ -7,15 +7,16 @@ from tf2_msgs.msg import TFMessage
 
 from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
 from ..subscriptions import TrackedSubscriber
-from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time
+from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time, tf_prefix
 
 
 class GazeboRosDiffDrive(DiffDrive):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         params = self.params
-        self.odom_frame = resolve_frame(params["odometryFrame"])
-        self.base_frame = resolve_frame(params["robotBaseFrame"])
+        prefix = tf_prefix(self.namespace)
+        self.odom_frame = resolve_frame(params["odometryFrame"], prefix)
+        self.base_frame = resolve_frame(params["robotBaseFrame"], prefix)
         self.publish_odom_tf = params["publishTf"] and params["publishOdomTF"]
         # publishTf=false means no odometry topic at all, not just no TF (gazebo_ros reads it that way).
         self.odom_publisher = (loop_publisher(resolve_in_namespace(self.namespace, params["odometryTopic"]),

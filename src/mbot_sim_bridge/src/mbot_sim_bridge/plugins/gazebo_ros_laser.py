@@ -3,17 +3,17 @@ import rospy
 from sensor_msgs.msg import LaserScan
 
 from ..core.lidar import RaySensor
-from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time, sensor_namespace
+from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time, sensor_namespace, tf_prefix
 
 
 class GazeboRosLaser(RaySensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         config = self.config
-        self.publisher = loop_publisher(resolve_in_namespace(sensor_namespace(self), self.params["topicName"]),
-                                        LaserScan)
+        namespace = sensor_namespace(self)
+        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), LaserScan)
         self.message = LaserScan()
-        self.message.header.frame_id = resolve_frame(self.params["frameName"])
+        self.message.header.frame_id = resolve_frame(self.params["frameName"], tf_prefix(namespace))
         self.message.angle_min, self.message.angle_max = config.min_angle, config.max_angle
         self.message.angle_increment = config.angle_increment
         self.message.range_min, self.message.range_max = config.range_min, config.range_max

@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Ten namespaced lidar mbots: their own topics and frames, their own cmd_vel, and scans that see the others."""
+import math
+import sys
+import threading
+import unittest
+
+import rospy
+import rostest
+from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+
+from sim_support import WALL_TIMEOUT, wait_for, yaw_of
+
+COUNT = 10
+ROBOTS = ["mbot_%d" % index for index in range(1, COUNT + 1)]
+LASER_X = 0.08  # laser_link ahead of base_footprint (mbot_with_laser_gazebo.xacro)
+LIDAR_RADIUS = 0.05  # what another robot shows at the scan's height: its lidar's cylinder
+
+
+class MultiMbot(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("multi_mbot_test")
+        rospy.wait_for_service("/gazebo/get_world_properties", timeout=WALL_TIMEOUT)
+        world = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
+        wait_for(lambda: set(ROBOTS) <= set(world().model_names), timeout=240, what="%d robots" % COUNT)
+        cls.state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.lock = threading.Lock()
+        cls.odom, cls.scans = {}, {}
+        cls.subscribers = []
+        for robot in ROBOTS:
+            cls.subscribers.append(rospy.Subscriber("/%s/odom" % robot, Odometry, cls.keep(cls.odom, robot)))
+            cls.subscribers.append(rospy.Subscriber("/%s/scan" % robot, LaserScan, cls.keep(cls.scans, robot)))
+        wait_for(lambda: len(cls.odom) == COUNT and len(cls.scans) == COUNT, what="odom and scan of every robot")
+
+    @classmethod
+    def keep(cls, store, robot):
+        def callback(message):
+            with cls.lock:
+                store[robot] = message
+        return callback
+
+    def test_topics_and_frames_are_per_robot(self):
+        for robot in ROBOTS:
+            with self.lock:
+                odom, scan = self.odom[robot], self.scans[robot]
+            self.assertEqual((odom.header.frame_id, odom.child_frame_id), (robot + "/odom", robot + "/base_footprint"))
+            self.assertEqual(scan.header.frame_id, robot + "/laser_link")
+
+    def test_each_scan_sees_its_nearest_neighbour(self):
+        poses = {robot: self.state(robot, "world").pose for robot in ROBOTS}
+        lasers = {robot: (pose.position.x + LASER_X * math.cos(yaw_of(pose.orientation)),
+                          pose.position.y + LASER_X * math.sin(yaw_of(pose.orientation)), yaw_of(pose.orientation))
+                  for robot, pose in poses.items()}
+        with self.lock:
+            scans = dict(self.scans)
+        worst = 0.0
+        for robot in ROBOTS:
+            x, y, heading = lasers[robot]
+            neighbour = min((other for other in ROBOTS if other != robot),
+                            key=lambda other: math.hypot(lasers[other][0] - x, lasers[other][1] - y))
+            dx, dy = lasers[neighbour][0] - x, lasers[neighbour][1] - y
+            bearing = math.atan2(math.sin(math.atan2(dy, dx) - heading), math.cos(math.atan2(dy, dx) - heading))
+            scan = scans[robot]
+            if not scan.angle_min <= bearing <= scan.angle_max:
+                continue  # behind the course lidar's 6-rad fan
+            beam = int(round((bearing - scan.angle_min) / scan.angle_increment))
+            measured = min(scan.ranges[max(0, beam - 2):beam + 3])
+            error = measured - (math.hypot(dx, dy) - LIDAR_RADIUS)
+            worst = max(worst, abs(error))
+            self.assertLess(abs(error), 0.06, "%s sees %s at %.3f m along %.2f rad, %.3f m off"
+                            % (robot, neighbour, measured, bearing, error))
+        print("figure: %d robots: each scan finds its nearest neighbour, worst error %.3f m" % (COUNT, worst))
+
+    def test_each_robot_drives_on_its_own_cmd_vel(self):
+        rates = {robot: 0.1 * (index + 1) * (-1) ** index for index, robot in enumerate(ROBOTS)}
+        publishers = {robot: rospy.Publisher("/%s/cmd_vel" % robot, Twist, queue_size=1, latch=True)
+                      for robot in ROBOTS}
+        for robot, publisher in publishers.items():
+            wait_for(lambda: publisher.get_num_connections() > 0, what="/%s/cmd_vel subscribed" % robot)
+            command = Twist()
+            command.angular.z = rates[robot]
+            publisher.publish(command)
+        wait_for(lambda: all(abs(self.odom[robot].twist.twist.angular.z - rates[robot]) < 0.02 for robot in ROBOTS),
+                 what="every robot turning at its own rate")
+        for publisher in publishers.values():
+            publisher.publish(Twist())
+        print("figure: %d robots turning at %s rad/s on their own cmd_vel"
+              % (COUNT, ", ".join("%.1f" % rate for rate in rates.values())))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_tests", "multi_mbot", MultiMbot, sys.argv)
