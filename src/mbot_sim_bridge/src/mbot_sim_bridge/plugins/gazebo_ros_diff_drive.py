@@ -24,6 +24,7 @@ class GazeboRosDiffDrive(DiffDrive):
         self.tf_publisher = loop_publisher("/tf", TFMessage) if self.publish_odom_tf else None
         self.joint_state_publisher = (loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
                                       if self.joint_states_published else None)
+        self._make_messages()
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
         self.subscriber = TrackedSubscriber(self.command_topic, Twist, self._on_command)
         if params["publishWheelTF"]:
@@ -45,42 +46,58 @@ class GazeboRosDiffDrive(DiffDrive):
                                    "keeping the last valid command" % (self.label, self.command_topic, linear, angular))
 
     def update(self, now: float):
+        # Topics nobody listens to are skipped: the loop publishes synchronously, so each costs real time.
         stamp = ros_time(now)
-        if self.odom_publisher is not None:
-            self._publish_odometry(stamp)
-        if self.joint_state_publisher is not None:
+        odometry_wanted = self.odom_publisher is not None and self.odom_publisher.get_num_connections()
+        tf_wanted = self.tf_publisher is not None and self.tf_publisher.get_num_connections()
+        if odometry_wanted or tf_wanted:
+            odometry = self.odometry()
+            if odometry_wanted:
+                self._publish_odometry(stamp, odometry)
+            if tf_wanted:
+                self._publish_odom_tf(stamp, odometry)
+        if self.joint_state_publisher is not None and self.joint_state_publisher.get_num_connections():
             self._publish_wheel_joint_states(stamp)
         super().update(now)
 
-    def _publish_odometry(self, stamp):
-        (position, orientation), (vx, vy), wz = self.odometry()
-        odometry = Odometry()
+    def _make_messages(self):
+        """The messages, built once and refilled at each update: building a genpy message costs more than
+        filling it."""
+        self.odometry_message = Odometry()
+        self.odometry_message.header.frame_id = self.odom_frame
+        self.odometry_message.child_frame_id = self.base_frame
+        self.odometry_message.pose.covariance = ODOM_POSE_COVARIANCE
+        transform = TransformStamped()
+        transform.header.frame_id = self.odom_frame
+        transform.child_frame_id = self.base_frame
+        self.tf_message = TFMessage([transform])
+        # gazebo_ros lists the right wheel first and leaves velocity and effort empty.
+        self.wheel_states = JointState()
+        self.wheel_states.name = [self.joints[1], self.joints[0]]
+
+    def _publish_odometry(self, stamp, odometry_values):
+        (position, orientation), (vx, vy), wz = odometry_values
+        odometry = self.odometry_message
         odometry.header.stamp = stamp
-        odometry.header.frame_id = self.odom_frame
-        odometry.child_frame_id = self.base_frame
         pose, twist = odometry.pose.pose, odometry.twist.twist
         pose.position.x, pose.position.y, pose.position.z = position
         pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = orientation
         twist.linear.x, twist.linear.y, twist.angular.z = vx, vy, wz
-        odometry.pose.covariance = ODOM_POSE_COVARIANCE
         self.odom_publisher.publish(odometry)
-        if self.tf_publisher is not None:
-            transform = TransformStamped()
-            # Not the odometry's header object: rospy wrote its publisher's counter into that one's seq.
-            transform.header.stamp, transform.header.frame_id = stamp, self.odom_frame
-            transform.child_frame_id = self.base_frame
-            translation = transform.transform.translation
-            translation.x, translation.y, translation.z = position
-            transform.transform.rotation = pose.orientation
-            self.tf_publisher.publish(TFMessage([transform]))
+
+    def _publish_odom_tf(self, stamp, odometry_values):
+        (position, orientation), _, _ = odometry_values
+        transform = self.tf_message.transforms[0]
+        transform.header.stamp = stamp
+        translation, rotation = transform.transform.translation, transform.transform.rotation
+        translation.x, translation.y, translation.z = position
+        rotation.x, rotation.y, rotation.z, rotation.w = orientation
+        self.tf_publisher.publish(self.tf_message)
 
     def _publish_wheel_joint_states(self, stamp):
-        # gazebo_ros lists the right wheel first and leaves velocity and effort empty.
-        message = JointState()
-        message.header.stamp = stamp
-        message.name = [self.joints[1], self.joints[0]]
-        message.position = [state[0] for state in self.context.robot.joint_state(message.name)]
-        self.joint_state_publisher.publish(message)
+        self.wheel_states.header.stamp = stamp
+        self.wheel_states.position = [state[0] for state in self.context.robot.joint_state(self.wheel_states.name)]
+        self.joint_state_publisher.publish(self.wheel_states)
 
     def close(self):
         self.subscriber.unregister()

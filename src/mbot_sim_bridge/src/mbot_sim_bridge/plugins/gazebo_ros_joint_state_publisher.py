@@ -9,11 +9,13 @@ class GazeboRosJointStatePublisher(JointStatePublisher):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         self.publisher = loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
+        self.message = JointState(name=self.joint_names)  # refilled at each update
 
     def update(self, now: float):
-        message = JointState()
+        if not self.publisher.get_num_connections():
+            return
+        message = self.message
         message.header.stamp = ros_time(now)
-        message.name = self.joint_names
         states = self.states()
         message.position = [state[0] for state in states]
         message.velocity = [state[1] for state in states]
