@@ -133,7 +133,7 @@ class SimBridgeNode:
 
     def _publish_clock(self, now: float):
         self.clock_publisher.publish(Clock(clock=ros_time(now)))
-        self.api.publish_model_states()
+        self.api.model_states.publish()
         # The timer guarantees the longest gap between two /clock messages, counted from the last one.
         self.clock_timer.reset(now)
         self._last_clock = now

@@ -9,7 +9,6 @@ from xml.etree import ElementTree
 
 import rospkg
 import rospy
-from gazebo_msgs.msg import ModelStates
 from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
                              GetPhysicsProperties, GetPhysicsPropertiesResponse, GetWorldProperties,
                              GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
@@ -26,7 +25,8 @@ from .core.model_path import default_model_path
 from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
 from .core.sdf_world import parse_world
-from .plugins import loop_publisher, ros_time
+from .model_states import ModelStatesPublisher
+from .plugins import ros_time
 from .subscriptions import drain
 
 _WORLD_FRAMES = ("", "world", "map", "/map")
@@ -74,7 +74,7 @@ class GazeboRosApi:
     def __init__(self, node):
         self.node = node
         self.sim = node.sim
-        self.model_states_publisher = loop_publisher("~model_states", ModelStates)
+        self.model_states = ModelStatesPublisher(self.sim)
         self._services = [
             rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
             rospy.Service("~spawn_sdf_model", SpawnModel, self._spawn_sdf_model),
@@ -196,7 +196,7 @@ class GazeboRosApi:
             twist = state.twist
             linear = rotate(reference.orientation, (twist.linear.x, twist.linear.y, twist.linear.z))
             angular = rotate(reference.orientation, (twist.angular.x, twist.angular.y, twist.angular.z))
-            self.sim.engine.set_model_state(state.model_name, pose, linear, angular)
+            self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
 
@@ -215,18 +215,6 @@ class GazeboRosApi:
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
             return response
         return self._guarded(GetPhysicsPropertiesResponse, get)
-
-    def publish_model_states(self):
-        """Model-frame world poses and world twists, only while someone listens (as gazebo_ros)."""
-        if self.model_states_publisher.get_num_connections() == 0:
-            return
-        engine = self.sim.engine
-        message = ModelStates()
-        for name in engine.model_names():
-            message.name.append(name)
-            message.pose.append(_pose_to_message(engine.model_pose(name)))
-            message.twist.append(_twist_message(*engine.model_velocity(name)))
-        self.model_states_publisher.publish(message)
 
 
 def _inject_namespace(model, namespace: str):

@@ -53,6 +53,8 @@ class Simulation:
         self.seed = seed
         self.joint_state_rate = joint_state_rate
         self.paused = False
+        # Changes whenever models come or go or are moved from outside: what caches of their poses check.
+        self.version = 0
         self.models: Dict[str, SpawnedModel] = {}
         # World models (from the .world and spawn_sdf_model) as described, by name.
         self.world_models: Dict[str, ModelDescription] = {}
@@ -97,6 +99,7 @@ class Simulation:
             if model.name in loaded.bodies:
                 self.world_models[model.name] = model
         self._build_order.append(description)
+        self.version += 1
         return list(loaded.bodies)
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
@@ -113,6 +116,7 @@ class Simulation:
             raise
         self.models[name] = spawned
         self._build_order.append(name)
+        self.version += 1
         self._schedule()
         if self.viewer is not None:
             self.viewer.show_robot(robot)
@@ -135,6 +139,12 @@ class Simulation:
             self._schedule()
         self.world_models.pop(name, None)
         self.engine.remove(name)
+        self.version += 1
+
+    def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
+        """Move a model and set its velocity (set_model_state, set from outside the physics)."""
+        self.engine.set_model_state(name, pose, linear, angular)
+        self.version += 1
 
     def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
         plugins: List[Plugin] = []
@@ -243,6 +253,7 @@ class Simulation:
                 generator.bit_generator.state = np.random.PCG64(sequence).state
         else:
             self.engine.reset_world()
+        self.version += 1
         for plugin in list(self._plugins):
             self._guarded(plugin, plugin.reset, self.sim_time)
 
