@@ -1,4 +1,6 @@
 """Fixtures shared by the workspace's pure-core unit tests (no ROS master)."""
+import logging
+
 import pybullet
 import pytest
 from mbot_sim_bridge.core.log import forget_warnings
@@ -15,5 +17,10 @@ def client():
 
 @pytest.fixture(autouse=True)
 def fresh_warnings():
-    """Each test sees its own once-only warnings."""
+    """Each test sees its own once-only warnings, and the bridge's log level as it starts (a robot's
+    rosDebugLevel tag changes it for the whole process)."""
     forget_warnings()
+    logger = logging.getLogger("rosout.mbot_sim_bridge")
+    level = logger.level
+    yield
+    logger.setLevel(level)

@@ -167,7 +167,8 @@ class SpawnedRobot:
                                           targetPosition=position, force=max_force)
 
     def set_joint_effort(self, joint_name: str, effort: float):
-        """A torque (or force) held until changed; PyBullet applies it only once the velocity motor is off."""
+        """A torque (or force) for the next physics step only (PyBullet's TORQUE_CONTROL); it acts only once
+        the joint's velocity motor is off (``release_joint``). Controllers send it again every step."""
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.TORQUE_CONTROL,
                                           force=effort)
 

@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""Scale figures, each as raw, bridge and their ratio (``./mbot bench``):
+
+- ten lidar mbots turning in the play ground: raw is the Simulation with the plugins' core classes (the same
+  PyBullet stepping, wheel control and ray casts, no ROS); the bridge is multi_mbot.launch count:=10 at real-time
+  factor 0 with every scan and odometry subscribed;
+- a world of 5,000 static boxes: raw is the PyBullet world stepped alone; the bridge loads it at real-time
+  factor 0 with every topic (model_states included) subscribed.
+Real-time factors are sim seconds per wall second; the bridge's is read from /clock over the window.
+"""
+import argparse
+import os
+import subprocess
+import tempfile
+import time
+
+import rospy
+from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from rosgraph_msgs.msg import Clock
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
+ROBOTS = 10
+BOXES = 5000
+
+
+def raw_robots_rtf(sim_seconds: float) -> float:
+    import xacro
+    from mbot_sim_bridge.core.diff_drive import DiffDrive
+    from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+    from mbot_sim_bridge.core.joint_states import JointStatePublisher
+    from mbot_sim_bridge.core.lidar import RaySensor
+    from mbot_sim_bridge.core.robot_model import parse_robot
+    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.simulation import Simulation
+
+    registry = {"libgazebo_ros_diff_drive.so": DiffDrive, "libgazebo_ros_laser.so": RaySensor,
+                "libgazebo_ros_joint_state_publisher.so": JointStatePublisher}
+    urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
+                                           "mbot_with_laser_gazebo.xacro"), mappings={}).toxml()
+    sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), registry)
+    for index in range(ROBOTS):  # the places and turn rates of multi_mbot.launch and the bridge run below
+        place = pose_from_xyz_rpy((-1.0 + 0.8 * (index % 5), -0.5 + 1.0 * (index // 5), 0), (0, 0, 0))
+        spawned = sim.spawn_robot(parse_robot(urdf), "mbot_%d" % (index + 1), place)
+        next(p for p in spawned.plugins if isinstance(p, DiffDrive)).set_command(0.0, turn_rate(index))
+    started = time.perf_counter()
+    sim.step(int(sim_seconds / sim.step_size))
+    elapsed = time.perf_counter() - started
+    sim.close()
+    return sim_seconds / elapsed
+
+
+def turn_rate(index: int) -> float:
+    return 0.1 * (index + 1) * (-1) ** index
+
+
+def box_world(path: str):
+    """BOXES static 0.2 m boxes on a 0.5 m grid, and the ground."""
+    rows = ["<sdf version='1.6'><world name='boxes'><include><uri>model://ground_plane</uri></include>"]
+    side = int(BOXES ** 0.5) + 1
+    for index in range(BOXES):
+        x, y = 0.5 * (index % side), 0.5 * (index // side)
+        rows.append("<model name='box_%d'><static>true</static><pose>%g %g 0.1 0 0 0</pose><link name='l'>"
+                    "<collision name='c'><geometry><box><size>0.2 0.2 0.2</size></box></geometry></collision>"
+                    "</link></model>" % (index, x, y))
+    rows.append("</world></sdf>")
+    with open(path, "w") as stream:
+        stream.write("\n".join(rows))
+
+
+def raw_boxes_rtf(world_path: str, sim_seconds: float) -> float:
+    from mbot_sim_bridge.core.engine import Engine
+    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.world_bodies import load_world
+
+    engine = Engine()
+    engine.add_world(load_world(engine.client, parse_world(world_path)))
+    started = time.perf_counter()
+    engine.step(int(sim_seconds / engine.physics.max_step_size))
+    elapsed = time.perf_counter() - started
+    engine.close()
+    return sim_seconds / elapsed
+
+
+def bridge_rtf(command, ready_topics, wall_seconds: float, commands=None) -> float:
+    """Launch ``command``; once every topic of ``ready_topics`` publishes, subscribe every topic and measure."""
+    launch = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not set(ready_topics) <= {topic for topic, _ in rospy.get_published_topics()}:
+            if time.monotonic() > deadline or launch.poll() is not None:
+                raise RuntimeError("%s did not come up" % " ".join(command))
+            time.sleep(0.2)
+        publishers = [rospy.Publisher(topic, message.__class__, queue_size=1, latch=True)
+                      for topic, message in (commands or {}).items()]
+        for publisher, message in zip(publishers, (commands or {}).values()):
+            publisher.publish(message)
+        clock = []
+        subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
+                                                                                m.clock.to_sec())))]
+        subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
+                        for topic, _ in rospy.get_published_topics() if topic != "/clock"]
+        time.sleep(2.0)  # every subscription connects, and the robots reach their commanded turn
+        window_start = len(clock)
+        time.sleep(wall_seconds)
+        (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
+        for item in subscribers + publishers:
+            item.unregister()
+        return (sim1 - sim0) / (wall1 - wall0)
+    finally:
+        stop_process_group(launch)
+
+
+def main():
+    from geometry_msgs.msg import Twist
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each raw run")
+    parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each bridge run is measured")
+    args = parser.parse_args()
+
+    def report(what, raw, bridge):
+        print("%s: raw PyBullet %.2f, bridge %.2f, bridge / raw %.2f" % (what, raw, bridge, bridge / raw), flush=True)
+
+    # The raw runs go first: once rospy is up, the plugins' rosDebugLevel Debug would print every tag read.
+    raw_robots = raw_robots_rtf(args.sim_seconds)
+    with tempfile.TemporaryDirectory() as directory:
+        world = os.path.join(directory, "boxes.world")
+        box_world(world)
+        raw_boxes = raw_boxes_rtf(world, args.sim_seconds)
+        with PrivateMaster() as master:
+            os.environ["ROS_MASTER_URI"] = master.uri
+            rospy.init_node("bench_scale", disable_signals=True)
+            commands = {}
+            for index in range(ROBOTS):
+                twist = Twist()
+                twist.angular.z = turn_rate(index)
+                commands["/mbot_%d/cmd_vel" % (index + 1)] = twist
+            bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", "count:=%d" % ROBOTS,
+                                 "gui:=false", "real_time_factor:=0"],
+                                ["/mbot_%d/odom" % n for n in range(1, ROBOTS + 1)], args.wall_seconds, commands)
+            report("%d lidar mbots, real-time factor" % ROBOTS, raw_robots, bridge)
+            bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
+                                 "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
+            report("%d static boxes, real-time factor" % BOXES, raw_boxes, bridge)
