@@ -2,9 +2,10 @@
 """Speed figures of the simulator, printed one per line (``./mbot bench``).
 
 (a) raw PyBullet: the course's mbot driven by the core's diff-drive loop in the empty world, no ROS;
-(b) the bridge: the course's empty-world launch file at real-time factor 0 with every topic subscribed;
-the real-time factor of each and their ratio, the wall time from roslaunch to the first /odom, and the
-cost of one lidar scan (bench_lidar.py).
+(b) the bridge: mbot_gazebo's mbot_world.launch (the mbot in the empty world) at real-time factor 0 with every
+topic subscribed; the real-time factor of each and their ratio, and the wall time from roslaunch to the first /odom;
+then ten robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
+(bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
 """
 import argparse
 import os
@@ -58,7 +59,7 @@ def bridge_figures(wall_seconds: float):
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
         rospy.init_node("bench_bridge", disable_signals=True)
         started = time.monotonic()
-        launch = subprocess.Popen(["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=false",
+        launch = subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false",
                                    "real_time_factor:=0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                   start_new_session=True)
         try:
@@ -93,7 +94,11 @@ def main():
     print("bridge real-time factor (%d topics subscribed): %.2f" % (topics, bridge))
     print("bridge / raw: %.2f" % (bridge / raw))
     print("roslaunch to first /odom: %.2f s" % first_odom, flush=True)
-    sys.exit(subprocess.call([sys.executable, os.path.join(HERE, "bench_lidar.py")]))
+    # The others, each in a process of its own (each starts its own master and rospy node).
+    for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_cameras.py"):
+        status = subprocess.call([sys.executable, os.path.join(HERE, script)])
+        if status:
+            sys.exit(status)
 
 
 if __name__ == "__main__":

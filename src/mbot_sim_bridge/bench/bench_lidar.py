@@ -22,7 +22,7 @@ from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig
 # The tutorial's rplidar (lidar_gazebo.xacro).
 RPLIDAR = RaySensorConfig(sensor_name="rplidar", link="laser_link", samples=360, min_angle=-3.0,
                           max_angle=3.0, range_min=0.10, range_max=6.0, update_rate=5.5,
-                          range_resolution=0.01, noise_mean=0.0, noise_stddev=0.01)
+                          noise_mean=0.0, noise_stddev=0.01)
 ROBOT_GROUP = 1 << 8
 # The mbot's laser_link sits 0.08 m ahead of and 0.072 m above base_footprint.
 LASER_IN_BASE = pose_from_xyz_rpy((0.08, 0.0, 0.072), (0.0, 0.0, 0.0))

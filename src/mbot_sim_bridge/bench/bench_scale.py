@@ -116,6 +116,7 @@ def main():
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each raw run")
+    parser.add_argument("--box-sim-seconds", type=float, default=0.5, help="sim time of the raw box-world run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each bridge run is measured")
     args = parser.parse_args()
 
@@ -127,7 +128,7 @@ def main():
     with tempfile.TemporaryDirectory() as directory:
         world = os.path.join(directory, "boxes.world")
         box_world(world)
-        raw_boxes = raw_boxes_rtf(world, args.sim_seconds)
+        raw_boxes = raw_boxes_rtf(world, args.box_sim_seconds)
         with PrivateMaster() as master:
             os.environ["ROS_MASTER_URI"] = master.uri
             rospy.init_node("bench_scale", disable_signals=True)
@@ -143,3 +144,7 @@ def main():
             bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
                                  "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
             report("%d static boxes, real-time factor" % BOXES, raw_boxes, bridge)
+
+
+if __name__ == "__main__":
+    main()

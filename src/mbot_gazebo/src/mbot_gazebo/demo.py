@@ -2,7 +2,8 @@
 
 Starts a private ROS master and the course's launch file at the fastest real-time factor the machine
 sustains, drives a scripted tour through /cmd_vel (closed loop on /odom, so distances and turns come out
-the same at any speed), records /odom and /scan (through TF into odom), and writes out/demo.png.
+the same at any speed), records /odom and /scan (through TF into odom), and writes out/demo.png with a
+picture of the world, as the course's kinect sees it from the final pose, beside the top view.
 """
 import argparse
 import math
@@ -175,7 +176,7 @@ def main(argv=None):
         os.environ.update(ROS_MASTER_URI=master.uri, ROS_LOG_DIR=log_dir)
         with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
             simulation = subprocess.Popen(
-                ["roslaunch", "mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "world_name:=" + world_path,
+                ["roslaunch", "mbot_gazebo", "mbot_world.launch", "world_name:=" + world_path,
                  "model:=" + model, "gui:=%s" % str(args.gui).lower(), "real_time_factor:=0"],
                 env=os.environ, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
@@ -184,6 +185,31 @@ def main(argv=None):
             return tour_and_draw(args, world_path, started)
         finally:
             stop_process_group(simulation)
+
+
+def camera_frame(world_path: str, x: float, y: float, yaw: float):
+    """What the course's kinect would see from the robot's final pose: one frame of the same camera code the
+    simulator runs (core/camera.py), rendered in a world of its own, without ROS."""
+    import xacro
+    from mbot_sim_bridge.core.camera import DepthCamera
+    from mbot_sim_bridge.core.diff_drive import DiffDrive
+    from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+    from mbot_sim_bridge.core.joint_states import JointStatePublisher
+    from mbot_sim_bridge.core.robot_model import parse_robot
+    from mbot_sim_bridge.core.simulation import Simulation
+
+    urdf = xacro.process_file(os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
+                                           "mbot_with_kinect_gazebo.xacro")).toxml()
+    registry = {"libgazebo_ros_openni_kinect.so": DepthCamera, "libgazebo_ros_diff_drive.so": DiffDrive,
+                "libgazebo_ros_joint_state_publisher.so": JointStatePublisher}
+    simulation = Simulation(parse_world(world_path), registry)
+    try:
+        spawned = simulation.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot",
+                                         pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, yaw)))
+        kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
+        return kinect.capture(simulation.sim_time).rgb
+    finally:
+        simulation.close()
 
 
 def tour_and_draw(args, world_path, started):
@@ -213,8 +239,10 @@ def tour_and_draw(args, world_path, started):
                "scans received: %d (%d points)" % (scans, len(points)),
                "final odometry: x %.3f m, y %.3f m, yaw %.1f deg" % (x, y, math.degrees(yaw))]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    camera = camera_frame(world_path, x, y, yaw)
     frame = draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
-                      title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings))
+                      title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings),
+                      camera_image=camera, camera_caption="the course's kinect at the end pose (640x480)")
     # Beside the picture: the recorded odometry and where the plot sits in the PNG, so the two can be compared.
     stem = os.path.splitext(args.out)[0]
     numpy.savetxt(stem + "_odometry.csv", numpy.column_stack([path, headings]), delimiter=",",

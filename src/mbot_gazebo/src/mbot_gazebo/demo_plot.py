@@ -1,4 +1,5 @@
-"""Top view of a demo run: the world's obstacles, the driven path and the lidar hits, as one PNG.
+"""Top view of a demo run: the world's obstacles, the driven path and the lidar hits, and optionally a camera
+picture of the world beside it, as one PNG.
 
 Pure matplotlib (Agg canvas, no pyplot state) and numpy, so it runs anywhere without ROS or a display::
 
@@ -78,12 +79,13 @@ class PlotFrame:
 
 
 def draw_demo(world, path_xy, scan_points_xy, out_path: str, title: str = "", summary_lines: Sequence[str] = (),
-              headings=None) -> PlotFrame:
+              headings=None, camera_image=None, camera_caption: str = "") -> PlotFrame:
     """Draw ``world`` (a WorldDescription), the driven path and the lidar hits, and save a PNG at ``out_path``.
 
     ``path_xy`` (N, 2) and ``scan_points_xy`` (M, 2) are in metres in the odom frame, which is the world frame
     for a robot spawned at the origin. ``headings`` (N,) in radians, if given, puts an arrow on the final
-    pose. ``summary_lines`` are printed under the plot. Returns the PlotFrame of the saved image.
+    pose. ``summary_lines`` are printed under the plot. ``camera_image`` (H, W, 3) uint8, if given, is shown
+    under the legend with ``camera_caption`` above it. Returns the PlotFrame of the saved image.
     """
     path = _finite_points(path_xy)
     scan = _finite_points(scan_points_xy)
@@ -135,9 +137,24 @@ def draw_demo(world, path_xy, scan_points_xy, out_path: str, title: str = "", su
         figure.text(_LEFT, (summary_px + _SUMMARY_LINE_PX / 2) / IMAGE_SIZE[1], "\n".join(summary_lines),
                     va="top", ha="left", family="monospace", fontsize=9)
 
+    if camera_image is not None:
+        _camera_view(figure, np.asarray(camera_image), camera_caption, bottom_px)
+
     # Saving draws the figure, which settles the equal-aspect limits that the frame reports.
     figure.savefig(out_path, dpi=_DPI)
     return _plot_frame(canvas, axes)
+
+
+def _camera_view(figure, image: np.ndarray, caption: str, bottom_px: float):
+    """The camera picture in the right-hand column, below the legend, at the bottom of the plot's box."""
+    width = 1.0 - _WIDTH - _LEFT - 0.05
+    height = width * IMAGE_SIZE[0] / IMAGE_SIZE[1] * image.shape[0] / image.shape[1]
+    axes = figure.add_axes([_LEFT + _WIDTH + 0.03, bottom_px / IMAGE_SIZE[1], width, height])
+    axes.imshow(image, interpolation="bilinear")
+    axes.set_xticks([])
+    axes.set_yticks([])
+    if caption:
+        axes.set_title(caption, fontsize=8)
 
 
 def _finite_points(points) -> np.ndarray:

@@ -25,6 +25,7 @@ from .core.sdf_world import parse_world
 from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
 from .core.xml_values import parse_bool
 from .plugins import loop_publisher, ros_time
+from .publisher_check import check_joint_state_publishers
 from .plugins.registry import REGISTRY
 from .services import GazeboRosApi
 
@@ -124,6 +125,7 @@ class SimBridgeNode:
                 continue
             until_clock = self.clock_timer.steps_until_due(self.sim.sim_time, self.step_size)
             self.sim.advance(min(until_clock, self._batch_steps), self._before_updates)
+            check_joint_state_publishers(rospy.get_name(), (model.namespace for model in self.sim.models.values()))
             self._pace()
 
     def _before_updates(self, now: float, plugins_due: bool):

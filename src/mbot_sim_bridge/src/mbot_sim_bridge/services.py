@@ -3,6 +3,7 @@
 Handlers run in rospy's threads; each converts the request into Simulation calls that run in the loop
 thread (``node.call_in_loop``) and the result back into a response.
 """
+import math
 import re
 import tempfile
 from xml.etree import ElementTree
@@ -14,7 +15,7 @@ from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, Ge
                              GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
                              SpawnModelResponse)
 from geometry_msgs.msg import Pose as PoseMessage
-from mbot_sim_msgs.srv import StepSimulation, StepSimulationResponse
+from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
@@ -28,6 +29,7 @@ from .core.sdf_world import parse_world
 from .model_states import ModelStatesPublisher
 from .plugins import ros_time
 from .subscriptions import drain
+from .world_saving import SaveWorldHandler
 
 _WORLD_FRAMES = ("", "world", "map", "/map")
 # How long a step request waits for the bridge's subscribers to handle what reached them.
@@ -37,7 +39,7 @@ LOCKSTEP_DRAIN_SECONDS = 5.0
 def _pose_from_message(message: PoseMessage) -> Pose:
     """The pose with its quaternion normalised, as gazebo_ros does; a zero quaternion is the identity."""
     q = message.orientation
-    norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) ** 0.5
+    norm = math.hypot(q.x, q.y, q.z, q.w)  # hypot, not a sum of squares: no overflow for huge components
     # A non-finite component stays non-finite here, and check_state refuses it by name.
     orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else (q.x / norm, q.y / norm, q.z / norm, q.w / norm)
     return Pose((message.position.x, message.position.y, message.position.z), orientation)
@@ -88,6 +90,8 @@ class GazeboRosApi:
             rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
             rospy.Service("~reset_world", Empty, self._empty(lambda: node.reset(simulation=False))),
             rospy.Service("~step_simulation", StepSimulation, self._step_simulation),
+            # The bridge's own; the loaded world's description is read again for its lights, scene and name.
+            rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
 
     def _empty(self, action):

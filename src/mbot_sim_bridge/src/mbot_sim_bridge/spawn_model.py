@@ -39,12 +39,17 @@ def parse_arguments(argv):
     parser.add_argument("-robot_namespace", default=None, help="namespace injected into the model's plugins "
                         "(default: this node's namespace)")
     parser.add_argument("-gazebo_namespace", default="/gazebo", help="namespace of the simulator's services")
+    parser.add_argument("-timeout", type=float, default=None, metavar="SECONDS",
+                        help="seconds to wait for the spawn and unpause services to appear (gazebo_ros 3's option; "
+                             "default: wait for ever, as gazebo_ros 2's spawn_model does)")
     parser.add_argument("-unpause", action="store_true", help="unpause physics after spawning")
     parser.add_argument("-wait", metavar="MODEL", help="wait until MODEL exists before spawning")
     parser.add_argument("-package_to_model", action="store_true",
                         help="accepted for compatibility: the bridge resolves package:// URIs itself")
     parser.add_argument("-b", dest="bond", action="store_true", help="delete the model when this node stops")
     arguments = parser.parse_args(argv)
+    if arguments.timeout is not None and not 0 < arguments.timeout < float("inf"):
+        parser.error("-timeout must be a number of seconds > 0, got %s" % arguments.timeout)
     if arguments.J:
         parser.error("-J (set_model_configuration) is not supported by the bridge")
     return arguments
@@ -100,13 +105,23 @@ def wait_for_model(arguments):
             return
 
 
+def wait_for_service(name: str, timeout):
+    rospy.loginfo("waiting for service %s", name)
+    try:
+        rospy.wait_for_service(name, timeout)
+    except rospy.ROSInterruptException:
+        raise  # shut down while waiting (Ctrl-C): main() exits 1 without a message
+    except rospy.ROSException:
+        raise SpawnError("service %s did not appear within %g s (-timeout): is the simulator running "
+                         "(roslaunch gazebo_ros empty_world.launch)?" % (name, timeout)) from None
+
+
 def spawn(arguments):
     service_name = "%s/spawn_%s_model" % (arguments.gazebo_namespace, "urdf" if arguments.urdf else "sdf")
     model_xml = read_model_xml(arguments)
     if arguments.wait:
         wait_for_model(arguments)
-    rospy.loginfo("waiting for service %s", service_name)
-    rospy.wait_for_service(service_name)
+    wait_for_service(service_name, arguments.timeout)
     namespace = arguments.robot_namespace if arguments.robot_namespace is not None else rospy.get_namespace()
     response = rospy.ServiceProxy(service_name, SpawnModel)(arguments.model, model_xml, namespace,
                                                             initial_pose(arguments), arguments.reference_frame)
@@ -114,7 +129,9 @@ def spawn(arguments):
         raise SpawnError("spawning '%s' failed: %s" % (arguments.model, response.status_message))
     rospy.loginfo("spawned '%s': %s", arguments.model, response.status_message)
     if arguments.unpause:
-        rospy.ServiceProxy(arguments.gazebo_namespace + "/unpause_physics", Empty)()
+        unpause_name = arguments.gazebo_namespace + "/unpause_physics"
+        wait_for_service(unpause_name, arguments.timeout)
+        rospy.ServiceProxy(unpause_name, Empty)()
 
 
 def main():

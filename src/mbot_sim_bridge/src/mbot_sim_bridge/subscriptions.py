@@ -82,6 +82,9 @@ class TrackedSubscriber:
         with self._lock:
             return not self._pending
 
+    def get_num_connections(self) -> int:
+        return self.subscriber.get_num_connections()
+
     def unregister(self):
         self.subscriber.unregister()
         if self in _TRACKED:

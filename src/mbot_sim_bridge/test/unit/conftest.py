@@ -10,7 +10,8 @@ def expand_xacro(relative_path: str) -> str:
     """Run the real xacro on a file of mbot_description, as robot_description would hold it."""
     os.environ["ROS_PACKAGE_PATH"] = WORKSPACE_SRC + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
     import xacro
-    return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path)).toxml()
+    # mappings: the xacro:arg defaults apply (xacro's Python API needs the argument map, even empty).
+    return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path), mappings={}).toxml()
 
 
 @pytest.fixture(scope="session")

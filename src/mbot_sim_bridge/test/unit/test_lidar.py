@@ -110,7 +110,7 @@ def test_parses_the_tutorial_rplidar():
     assert config.update_rate == 5.5
     assert (config.samples, config.resolution, config.min_angle, config.max_angle) == (360, 1.0, -3.0, 3.0)
     assert (config.vertical_samples, config.vertical_min_angle, config.vertical_max_angle) == (1, 0.0, 0.0)
-    assert (config.range_min, config.range_max, config.range_resolution) == (0.10, 6.0, 0.01)
+    assert (config.range_min, config.range_max) == (0.10, 6.0)
     assert (config.noise_mean, config.noise_stddev) == (0.0, 0.01)
     assert config.range_count == 360
     assert config.angle_increment == pytest.approx(6.0 / 359)

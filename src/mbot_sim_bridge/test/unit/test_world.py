@@ -321,8 +321,9 @@ def test_world_lateral_friction_is_the_smallest_of_mu_mu2_and_1(mu, mu2, expecte
 
 def test_loaded_collisions_get_the_friction_rule_and_no_bounce(client):
     loaded = build(client, read_test_world("include.world"))
-    ground = client.getDynamicsInfo(loaded.bodies["ground_plane"], 0)
-    box = client.getDynamicsInfo(loaded.bodies["versioned_box"], 0)
+    # A static model of one collision is a single object: its only link is -1.
+    ground = client.getDynamicsInfo(loaded.bodies["ground_plane"], -1)
+    box = client.getDynamicsInfo(loaded.bodies["versioned_box"], -1)
     assert (ground[1], ground[5]) == (1.0, 0.0)  # lateral friction, restitution
     assert box[1] == pytest.approx(0.3)
 

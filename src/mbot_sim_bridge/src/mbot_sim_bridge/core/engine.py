@@ -91,6 +91,10 @@ def check_state(what: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0
                 raise ModelError(f"{what}: {name}.{axis} is {value}, not a finite number; nothing was changed")
             if abs(value) > limit * (1.0 + 1e-9):
                 raise ModelError(f"{what}: {name}.{axis} = {value:g} is outside ±{limit:g}; nothing was changed")
+    norm = math.hypot(*pose.orientation)
+    if abs(norm - 1.0) > 1e-6:
+        raise ModelError(f"{what}: orientation {tuple(pose.orientation)} is not a unit quaternion (norm {norm:g}); "
+                         f"nothing was changed")
 
 
 def _friction(text: str, model: str, link: str) -> float:

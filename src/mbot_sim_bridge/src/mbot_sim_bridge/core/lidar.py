@@ -53,7 +53,7 @@ RAY_SENSOR_PARAMS = (
     Param("ray/scan/vertical/max_angle", float, 0.0, "highest layer (rad)", warn_if_missing=False),
     non_negative("ray/range/min", float, None, "rays start here (m)", required=True),
     positive("ray/range/max", float, None, "longest reading (m)", required=True),
-    non_negative("ray/range/resolution", float, 0.0, "reported only: Gazebo does not quantize with it",
+    non_negative("ray/range/resolution", float, 0.0, "checked, and without effect, as in Gazebo (no quantizing)",
                  warn_if_missing=False),
     Param("ray/noise/type", str, "gaussian", "gaussian or none", warn_if_missing=False),
     Param("ray/noise/mean", float, 0.0, "m", warn_if_missing=False),
@@ -67,6 +67,10 @@ LASER_PARAMS = (
     Param("robotNamespace", str, "", "absent: the simulator's namespace; empty: the model name",
           warn_if_missing=False),
 )
+
+# Ranges in one scan at most: a 64-layer 3D lidar has about 130,000. Far more (a typo in <samples> or
+# <resolution>) would take the memory and time of the whole simulator for each scan.
+MAX_RANGES_PER_SCAN = 1 << 18
 
 # A batch of exactly MAX_RAY_INTERSECTION_BATCH_SIZE rays returns one result short in pybullet 3.2.7.
 _MAX_RAYS_PER_BATCH = pybullet.MAX_RAY_INTERSECTION_BATCH_SIZE - 1
@@ -90,7 +94,6 @@ class RaySensorConfig:
     vertical_resolution: float = 1.0
     vertical_min_angle: float = 0.0
     vertical_max_angle: float = 0.0
-    range_resolution: float = 0.0  # reported in the message only; Gazebo does not quantize with it
     noise_mean: Optional[float] = None  # None: no gaussian noise
     noise_stddev: Optional[float] = None
 
@@ -155,7 +158,6 @@ def parse_ray_sensor(sensor_element: ET.Element, link_name: str, document: XmlDo
         vertical_max_angle=values["ray/scan/vertical/max_angle"],
         range_min=values["ray/range/min"],
         range_max=values["ray/range/max"],
-        range_resolution=values["ray/range/resolution"],
         noise_mean=noise_mean,
         noise_stddev=noise_stddev,
     )
@@ -190,6 +192,11 @@ def _check_consistency(config: RaySensorConfig, where: str) -> None:
     if config.vertical_range_count < 1:
         raise ConfigError(f"{where}: <vertical><samples> × <vertical><resolution> = "
                           f"{config.vertical_samples * config.vertical_resolution} leaves no ranges")
+    # Compared as floats: the counts of a typo can be too large to turn into arrays, or into ints at all.
+    ranges = config.samples * config.resolution * config.vertical_samples * config.vertical_resolution
+    if ranges > MAX_RANGES_PER_SCAN:
+        raise ConfigError(f"{where}: <samples> × <resolution> × <vertical><samples> × <vertical><resolution> = "
+                          f"{ranges:g} ranges per scan; at most {MAX_RANGES_PER_SCAN} are simulated")
 
 
 class RaySensor(Plugin):

@@ -62,3 +62,18 @@ def sdf_material_rgba(material: Optional[ElementTree.Element]) -> Optional[RGBA]
             if len(values) in (3, 4):
                 return tuple(values[:3]) + (values[3] if len(values) == 4 else 1.0,)
     return None
+
+
+def colour_robot(robot):
+    """Gazebo materials on a robot's links, as the simulator window shows them (the heaviest of lumped links
+    decides, since PyBullet colours a link's visuals as a whole)."""
+    colours = {}
+    for link in robot.model.links.values():
+        rgba = gazebo_material_rgba(link.gazebo_tag("material") or "")
+        if rgba is None or link.name not in robot.model.lumped_into:
+            continue
+        index = robot.link_index[robot.model.lumped_into[link.name][0]]
+        if index not in colours or link.mass > colours[index][0]:
+            colours[index] = (link.mass, rgba)
+    for index, (_, rgba) in colours.items():
+        robot.client.changeVisualShape(robot.body, index, rgbaColor=rgba)

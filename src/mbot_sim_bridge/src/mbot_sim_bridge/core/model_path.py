@@ -1,22 +1,93 @@
-"""Where ``model://NAME`` is looked up, in Gazebo's order.
+"""Where ``model://NAME`` and world files are looked up, in Gazebo's order.
 
-GAZEBO_MODEL_PATH comes first, then this workspace's ``worlds/models``. A model directory is one that holds a
-``model.config`` (or the deprecated ``manifest.xml``).
+Models: GAZEBO_MODEL_PATH comes first, then the ``gazebo_model_path`` that packages export in their package.xml
+(``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>``, as gazebo_ros's paths plugin adds
+them), then this workspace's ``worlds/models``. A model directory is one that holds a ``model.config`` (or the
+deprecated ``manifest.xml``). Resources (world files, ``file://`` URIs): GAZEBO_RESOURCE_PATH, then the
+exported ``gazebo_media_path``, then the workspace folder that holds ``worlds/empty.world`` (as Gazebo's own
+share folder does, so gazebo_ros's default ``worlds/empty.world`` resolves).
+
+The exports are collected with ``rospack plugins``, the command gazebo_ros's paths plugin runs through
+librospack: it reads package.xml files on ROS_PACKAGE_PATH, needs no ROS master, and lists only packages that
+depend on gazebo_ros directly, with ``${prefix}`` replaced by the package's folder.
 """
 import os
+import subprocess
 from pathlib import Path
 from typing import List, Optional, Sequence
 
+from .log import get_logger, warn_once
+
 MODEL_MANIFESTS = ("model.config", "manifest.xml")
+# rospack answers from its cache in milliseconds; a first crawl of a large ROS_PACKAGE_PATH takes longer.
+_ROSPACK_TIMEOUT_SECONDS = 60.0
+
+_log = get_logger(__name__)
 
 
 def default_model_path() -> List[str]:
-    """Directories searched for ``model://NAME``: GAZEBO_MODEL_PATH, then this workspace's worlds/models."""
-    directories = [entry for entry in os.environ.get("GAZEBO_MODEL_PATH", "").split(":") if entry]
+    """Directories searched for ``model://NAME``: GAZEBO_MODEL_PATH, the packages' gazebo_model_path
+    exports, then this workspace's worlds/models."""
+    directories = _environment_path("GAZEBO_MODEL_PATH") + package_exports("gazebo_model_path")
     workspace_models = _workspace_models()
     if workspace_models:
         directories.append(workspace_models)
+    return _unique(directories)
+
+
+def default_resource_path() -> List[str]:
+    """Directories world files and ``file://`` URIs are relative to: GAZEBO_RESOURCE_PATH, the packages'
+    gazebo_media_path exports, then the workspace folder holding worlds/."""
+    directories = _environment_path("GAZEBO_RESOURCE_PATH") + package_exports("gazebo_media_path")
+    workspace_models = _workspace_models()
+    if workspace_models:
+        directories.append(os.path.dirname(os.path.dirname(workspace_models)))
+    return _unique(directories)
+
+
+def package_exports(attribute: str) -> List[str]:
+    """The folders packages export to gazebo_ros under ``attribute`` (gazebo_model_path, gazebo_media_path,
+    plugin_path), in rospack's order; each value may hold several folders separated by ':'."""
+    command = ["rospack", "plugins", "--attrib=" + attribute, "gazebo_ros"]
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=_ROSPACK_TIMEOUT_SECONDS)
+    except FileNotFoundError:
+        warn_once(_log, "rospack is not installed (Debian package rospack-tools): the %s that packages export "
+                        "in package.xml are not searched" % attribute)
+        return []
+    except subprocess.TimeoutExpired:
+        warn_once(_log, "'%s' took more than %.0f s: the %s exports are not searched"
+                  % (" ".join(command), _ROSPACK_TIMEOUT_SECONDS, attribute))
+        return []
+    if result.returncode != 0:
+        # No gazebo_ros on ROS_PACKAGE_PATH (a plain pytest run, an unsourced shell): nothing can export to it.
+        _log.debug("%s: %s", " ".join(command), result.stderr.strip())
+        return []
+    directories = []
+    for line in result.stdout.splitlines():
+        _package, _, value = line.strip().partition(" ")
+        directories += [entry for entry in value.split(":") if entry.strip()]
     return directories
+
+
+def find_world_file(name: str, resource_path: Sequence[str]) -> Optional[str]:
+    """``name`` as an existing file (absolute or relative to the current directory), else the first
+    ``resource_path`` directory holding it, as gzserver resolves its world argument; None if none does."""
+    if os.path.isfile(name):
+        return os.path.abspath(name)
+    if os.path.isabs(name):
+        return None
+    return next((os.path.join(directory, name) for directory in resource_path
+                 if os.path.isfile(os.path.join(directory, name))), None)
+
+
+def _environment_path(variable: str) -> List[str]:
+    return [entry for entry in os.environ.get(variable, "").split(":") if entry]
+
+
+def _unique(directories: Sequence[str]) -> List[str]:
+    # A folder named twice (GAZEBO_MODEL_PATH and an export) is searched once, at its first place.
+    return list(dict.fromkeys(directories))
 
 
 def _workspace_models() -> Optional[str]:

@@ -19,7 +19,7 @@ from xml.etree import ElementTree
 from .errors import ModelError
 from .geometry import IDENTITY, Pose, compose
 from .log import get_logger, warn_once
-from .xml_values import XmlDocument, parse_xml, read_attribute_numbers, read_origin
+from .xml_values import XmlDocument, check_range, parse_floats, parse_xml, read_attribute_numbers, read_origin
 
 _logger = get_logger(__name__)
 
@@ -40,6 +40,12 @@ LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", 
 # parent's mass and inertia unchanged to within rounding, as Gazebo's lumping does.
 _NEGLIGIBLE_MASS = 1e-9
 _NEGLIGIBLE_INERTIA = 1e-12
+# Shapes no larger than the farthest a model may be placed (engine.MAX_POSITION, m).
+_MAX_SHAPE_SIZE = 1e5
+_SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
+# kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
+_MAX_MASS = 1e9
+_MAX_INERTIA = 1e9
 
 
 @dataclass
@@ -149,10 +155,16 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         link_name = element.get("name")
         if not link_name:
             raise ModelError("%s: a <link> has no name" % source)
+        if link_name in links:
+            raise ModelError("%s: link '%s' is defined twice" % (source, link_name))
         inertial = element.find("inertial")
         mass = 0.0
         if inertial is not None and inertial.find("mass") is not None:
             mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
+            try:
+                check_range(mass, 0.0, _MAX_MASS)
+            except ValueError as error:
+                raise ModelError("%s: link '%s': <mass value>: %s" % (source, link_name, error)) from None
         kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
                  if geometry is not None and len(geometry)]
         links[link_name] = Link(link_name, inertial is not None and mass > 0, mass, kinds)
@@ -162,7 +174,11 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     joints: Dict[str, Joint] = {}
     for element in root.findall("joint"):
         joint_name = element.get("name")
+        if not joint_name:
+            raise ModelError("%s: a <joint> has no name" % source)
         where = "%s joint '%s'" % (source, joint_name)
+        if joint_name in joints:
+            raise ModelError("%s: defined twice" % where)
         joint_type = element.get("type")
         if joint_type not in SUPPORTED_JOINT_TYPES:
             raise ModelError("%s: type '%s' is not supported; use one of %s"
@@ -173,6 +189,10 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         for role, link_name in (("parent", parent.get("link")), ("child", child.get("link"))):
             if link_name not in links:
                 raise ModelError("%s: %s link '%s' is not defined" % (where, role, link_name))
+        # URDF allows one parent; PyBullet would keep one of two silently (and crash on a duplicate joint).
+        other = next((j.name for j in joints.values() if j.child == child.get("link")), None)
+        if other is not None:
+            raise ModelError("%s: child link '%s' already has a parent joint, '%s'" % (where, child.get("link"), other))
         axis = element.find("axis")
         joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
                                    read_origin(element, document),
@@ -184,13 +204,17 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     roots = [link_name for link_name in links if link_name not in children]
     if len(roots) != 1:
         raise ModelError("%s: expected one root link, found %s" % (source, ", ".join(roots) or "none (a loop)"))
+    unreachable = set(links) - set(_subtree(roots[0], joints))
+    if unreachable:
+        raise ModelError("%s: links %s form a loop, not reachable from root link '%s'"
+                         % (source, ", ".join(sorted(unreachable)), roots[0]))
 
     plugins = _collect_gazebo_blocks(root, links, joints, source)
     transmissions = root.findall("transmission")
     dropped = _drop_massless_moving_links(links, joints, source)
     lumped_into = _lump_fixed_links(roots[0], links, joints)
     return RobotModel(name, roots[0], links, joints, plugins, lumped_into,
-                      _pybullet_urdf(root, links, dropped, source), transmissions, document)
+                      _pybullet_urdf(root, links, dropped, document, source), transmissions, document)
 
 
 def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:
@@ -231,10 +255,15 @@ def _check_link_tag(child: ElementTree.Element, reference: str, source: str):
 
 
 def _subtree(link_name, joints) -> List[str]:
+    """``link_name`` and every link below it. It ends on any input: with one parent per link (checked by
+    parse_robot) a loop cannot hang below the root."""
     names = [link_name]
-    for joint in joints.values():
-        if joint.parent == link_name:
-            names.extend(_subtree(joint.child, joints))
+    pending = [link_name]
+    while pending:
+        parent = pending.pop()
+        children = [joint.child for joint in joints.values() if joint.parent == parent]
+        names.extend(children)
+        pending.extend(children)
     return names
 
 
@@ -290,31 +319,83 @@ def _mesh_problem(filename: str) -> Optional[str]:
     return None
 
 
-def _check_meshes(root: ElementTree.Element, source: str):
-    """A collision mesh that cannot be read refuses the model; a visual one is left out with a warning (the
-    simulation does not need it, and PyBullet would refuse the whole URDF for it)."""
-    for link in root.findall("link"):
+def _shape_problem(element: ElementTree.Element) -> Optional[str]:
+    """Why PyBullet could not build the shape of a <visual> or <collision>, or None. PyBullet refuses the whole
+    URDF for it without saying where ("Cannot load URDF file"), or builds a shape from NaN."""
+    geometry = element.find("geometry")
+    shapes = [] if geometry is None else list(geometry)
+    if len(shapes) != 1:
+        return "<geometry> needs one shape (box, cylinder, sphere or mesh), found %s" % (
+            ", ".join("<%s>" % shape.tag for shape in shapes) or "none")
+    shape = shapes[0]
+    if shape.tag == "mesh":
+        problem = _mesh_problem(shape.get("filename", ""))
+        if problem is not None:
+            return "mesh '%s': %s" % (shape.get("filename", ""), problem)
+        return _numbers_problem(shape, "scale", 3, optional=True, minimum=None)
+    if shape.tag not in _SHAPE_SIZES:
+        return "<%s> is not a URDF shape (box, cylinder, sphere or mesh)" % shape.tag
+    for attribute, count in _SHAPE_SIZES[shape.tag]:
+        problem = _numbers_problem(shape, attribute, count, optional=False, minimum=0.0)
+        if problem is not None:
+            return problem
+    return None
+
+
+def _numbers_problem(shape: ElementTree.Element, attribute: str, count: int, optional: bool,
+                     minimum: Optional[float]) -> Optional[str]:
+    text = shape.get(attribute)
+    if text is None:
+        return None if optional else "<%s> needs %s" % (shape.tag, attribute)
+    try:
+        for value in parse_floats(text, count):
+            check_range(abs(value) if minimum is None else value, minimum or 0.0, _MAX_SHAPE_SIZE,
+                        exclusive_minimum=True)
+    except ValueError as error:
+        return "<%s %s>: %s" % (shape.tag, attribute, error)
+    return None
+
+
+def _check_links(root: ElementTree.Element, copied: ElementTree.Element, document: XmlDocument, source: str):
+    """Shapes, origins and inertials PyBullet could not load or that would make NaN. A bad collision refuses the
+    model; a bad visual is left out of ``copied`` (the URDF PyBullet gets) with a warning: the simulation does
+    not need it, and PyBullet would refuse the whole URDF for it."""
+    for link, copied_link in zip(root.findall("link"), copied.findall("link")):
+        _check_inertial(link.find("inertial"), document, "%s: link '%s'" % (source, link.get("name")))
         for kind in ("collision", "visual"):
-            for element in link.findall(kind):
-                mesh = element.find("geometry/mesh")
-                if mesh is None:
-                    continue
-                problem = _mesh_problem(mesh.get("filename", ""))
+            for element, copied_element in zip(link.findall(kind), copied_link.findall(kind)):
+                read_origin(element, document)
+                problem = _shape_problem(element)
                 if problem is None:
                     continue
-                message = "%s: link '%s' %s mesh '%s': %s" % (
-                    source, link.get("name"), kind, mesh.get("filename", ""), problem)
+                message = "%s: link '%s' %s %s" % (source, link.get("name"), kind, problem)
                 if kind == "collision":
                     raise ModelError(message)
                 warn_once(_logger, message + "; the visual is left out")
-                link.remove(element)
+                copied_link.remove(copied_element)
 
 
-def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], source: str) -> str:
+def _check_inertial(inertial: Optional[ElementTree.Element], document: XmlDocument, where: str):
+    if inertial is None:
+        return
+    read_origin(inertial, document)
+    inertia = inertial.find("inertia")
+    if inertia is None:
+        return
+    for name in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"):
+        value = read_attribute_numbers(inertia, name, document, (0.0,), 1)[0]
+        try:
+            check_range(value if name in ("ixx", "iyy", "izz") else abs(value), 0.0, _MAX_INERTIA)
+        except ValueError as error:
+            raise ModelError("%s: <inertia %s>: %s" % (where, name, error)) from None
+
+
+def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], document: XmlDocument,
+                   source: str) -> str:
     """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless,
-    meshes checked."""
-    root = copy.deepcopy(root)
-    _check_meshes(root, source)
+    shapes, origins and inertials checked."""
+    original, root = root, copy.deepcopy(root)
+    _check_links(original, root, document, source)
     for element in list(root):
         if element.tag in ("gazebo", "transmission"):
             root.remove(element)

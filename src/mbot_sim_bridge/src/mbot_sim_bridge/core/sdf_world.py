@@ -78,7 +78,6 @@ class Shape:
     length: float = 0.0
     normal: Tuple[float, float, float] = (0.0, 0.0, 1.0)
     mesh_path: Optional[str] = None
-    mesh_scale: Tuple[float, float, float] = (1.0, 1.0, 1.0)
     mesh: Optional[TriangleMesh] = field(default=None, compare=False, repr=False)  # scaled, collision frame
     mu: float = 1.0
     mu2: float = 1.0
@@ -503,7 +502,7 @@ class _WorldParser:
         scale = read_vector(mesh, "scale", document, (1.0, 1.0, 1.0))
         scaled = triangles.scaled(scale)
         size = tuple(float(v) for v in scaled.vertices.max(axis=0) - scaled.vertices.min(axis=0))
-        return Shape(size=size, mesh_path=path, mesh_scale=scale, mesh=scaled, **common)
+        return Shape(size=size, mesh_path=path, mesh=scaled, **common)
 
     def _physics(self, document: XmlDocument, world: ET.Element) -> PhysicsConfig:
         candidates = world.findall("physics")

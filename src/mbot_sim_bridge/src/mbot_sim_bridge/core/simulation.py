@@ -6,7 +6,6 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 (Gazebo file name -> class) handed in, so the core never imports the ROS plugin layer.
 """
 import hashlib
-import logging
 from dataclasses import dataclass, field, replace
 from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 from xml.etree import ElementTree
@@ -28,6 +27,8 @@ _logger = get_logger(__name__)
 
 # The bridge publishes the joint states no plugin publishes through this plugin, as a Gazebo user would add it.
 JOINT_STATE_PLUGIN = "libgazebo_ros_joint_state_publisher.so"
+# Above this many links a spawn takes seconds (PyBullet's URDF import): said first, so a pause is explained.
+LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
 MAX_BATCH_SIM_SECONDS = 0.01
 
@@ -47,6 +48,7 @@ class SpawnedModel:
 class Simulation:
     def __init__(self, world: WorldDescription, registry: Mapping[str, type], seed: int = 0,
                  connection_mode: int = pybullet.DIRECT, joint_state_rate: float = 100.0):
+        self.world = world  # the description the simulation was loaded from
         self.engine = Engine(world.physics, connection_mode)
         self.viewer = Viewer(self.engine) if connection_mode == pybullet.GUI else None
         self.registry = registry
@@ -104,6 +106,8 @@ class Simulation:
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
         """Put a parsed robot in the engine with its plugins; on any error, leave nothing of it behind."""
+        if len(model.links) > LARGE_MODEL_LINKS:
+            _logger.info("model '%s': %d links; PyBullet takes a while to load that many", name, len(model.links))
         robot = self.engine.spawn_robot(model, name, pose, namespace, driven_joints=None)
         spawned = SpawnedModel(name, namespace, robot)
         try:
@@ -233,9 +237,10 @@ class Simulation:
         """A plugin that raises is logged once, closed and dropped; the simulation and other models go on."""
         try:
             method(argument)
-        except Exception:  # the plugin boundary: any failure inside one plugin must not stop the others
-            _logger.log(logging.ERROR, "model '%s': plugin %s failed and is disabled", plugin.context.model.name,
-                        plugin.label, exc_info=True)
+        except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
+            _logger.error("model '%s': plugin %s failed and is disabled: %s: %s", plugin.context.model.name,
+                          plugin.label, type(error).__name__, error)
+            _logger.debug("the failure of %s", plugin.label, exc_info=True)
             plugin.context.model.plugins.remove(plugin)
             try:
                 plugin.close()

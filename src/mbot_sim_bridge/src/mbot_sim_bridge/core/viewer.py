@@ -6,7 +6,7 @@ import pybullet
 
 from .engine import Engine, SpawnedRobot
 from .geometry import yaw
-from .materials import gazebo_material_rgba
+from .materials import colour_robot
 
 # Close enough to see the 0.32 m mbot and what is around it, from behind and above.
 _CAMERA_DISTANCE, _CAMERA_PITCH_DEGREES = 1.2, -30.0
@@ -33,17 +33,7 @@ class Viewer:
         PyBullet colours a link's visuals as a whole, so links lumped together (the course's base_link and
         laser_link into base_footprint) take the material of the heaviest of them.
         """
-        client = self.engine.client
-        colours = {}
-        for link in robot.model.links.values():
-            rgba = gazebo_material_rgba(link.gazebo_tag("material") or "")
-            if rgba is None or link.name not in robot.model.lumped_into:
-                continue
-            index = robot.link_index[robot.model.lumped_into[link.name][0]]
-            if index not in colours or link.mass > colours[index][0]:
-                colours[index] = (link.mass, rgba)
-        for index, (_, rgba) in colours.items():
-            client.changeVisualShape(robot.body, index, rgbaColor=rgba)
+        colour_robot(robot)
         if self.followed is None:
             self.followed = robot
             # Behind the robot, looking along its heading.

@@ -6,7 +6,8 @@ whose poses in the model frame do not change (SDF joints are not simulated, so a
 Lights, scene and the other non-model world elements are copied; physics and gravity come from the
 settings in use. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
 converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
-Poses are written as world poses, so ``relative_to`` frames are not needed and not written.
+Model poses are written as world poses, so world ``<frame>``s are not needed and not written. The file is
+SDF 1.6, or 1.7 when a model written back uses 1.7's ``relative_to``/``attached_to`` frames.
 """
 import copy
 import math
@@ -14,7 +15,7 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Iterable, Mapping, Optional, Sequence
+from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
 
 from .errors import WorldError
 from .geometry import Pose, compose, inverse, rpy
@@ -22,6 +23,8 @@ from .robot_model import RobotModel
 from .sdf_world import ModelDescription, PhysicsConfig, WorldDescription
 
 SDF_VERSION = "1.6"
+# Frame semantics that came with 1.7; a copied model that uses them makes the file 1.7 (Gazebo 11 reads both).
+_SDF_1_7_ATTRIBUTES = ("relative_to", "attached_to")
 # sdformat's URDF import gives continuous joints these limits (SDF 1.6 has no "continuous" type).
 _CONTINUOUS_LIMIT = 1e16
 _GEOMETRY_SIZES = {"box": ("size",), "cylinder": ("radius", "length"), "sphere": ("radius",)}
@@ -35,10 +38,32 @@ class SavedRobot:
     link_poses: Mapping[str, Pose]
 
 
+class WorldSnapshot(NamedTuple):
+    models: List[ModelDescription]  # world models (the world file's and spawn_sdf_model's), in load order
+    poses: Dict[str, Pose]  # model name -> world pose of its model frame now
+    robots: List[SavedRobot]  # URDF robots, with the world pose of every URDF link now (when asked for)
+    robot_names: List[str]  # every URDF robot, written or not
+
+
+def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
+    """What a save needs from a ``core.simulation.Simulation``, read in the thread that owns its engine."""
+    engine = simulation.engine
+    models = [model for name, model in simulation.world_models.items() if name in engine.model_names()]
+    poses = {model.name: engine.model_pose(model.name) for model in models}
+    robots = []
+    if with_robots:
+        for name, spawned in simulation.models.items():
+            robot = spawned.robot
+            links = {link: robot.link_world_pose(link) for link in robot.model.lumped_into}
+            robots.append(SavedRobot(name, robot.model, links))
+    return WorldSnapshot(models, poses, robots, list(simulation.models))
+
+
 def pose_text(pose: Pose) -> str:
-    """``x y z roll pitch yaw``; 9 significant digits keep well under a micrometre and a microradian."""
+    """``x y z roll pitch yaw`` to the micrometre and microradian: PyBullet keeps poses in single precision,
+    so more digits would only be its rounding (5.30000019 for 5.3)."""
     values = tuple(pose.position) + tuple(rpy(pose.orientation))
-    return " ".join(_number(value) for value in values)
+    return " ".join(_number(round(value, 6)) for value in values)
 
 
 def _number(value: float) -> str:
@@ -63,6 +88,8 @@ def world_sdf(world: WorldDescription, models: Sequence[ModelDescription], poses
         element.append(_model_element(model, poses[model.name], base if id(model) in main_models else None))
     for robot in robots:
         element.append(robot_model_element(robot))
+    if any(item.get(attribute) is not None for item in root.iter() for attribute in _SDF_1_7_ATTRIBUTES):
+        root.set("version", "1.7")
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
@@ -101,8 +128,12 @@ def _set_child(parent: ET.Element, tag: str, text: str):
 def _absolute_file_uris(uris: Iterable[ET.Element], base: str):
     for uri in uris:
         text = (uri.text or "").strip()
-        if text and "://" not in text and not os.path.isabs(text):
-            uri.text = os.path.normpath(os.path.join(base, text))
+        path = text[len("file://"):] if text.startswith("file://") else text
+        if path and "://" not in path and not os.path.isabs(path):
+            candidate = os.path.normpath(os.path.join(base, path))
+            # file://media/... names Gazebo's own resources, which are not next to the world file.
+            if os.path.exists(candidate):
+                uri.text = candidate
 
 
 # --- URDF robots -------------------------------------------------------------------------------------------

@@ -1,0 +1,1 @@
+"""Command-line clients of ros_control's controller manager services (spawner, unspawner, controller_manager)."""

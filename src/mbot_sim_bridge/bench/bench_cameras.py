@@ -1,0 +1,179 @@
+#!/usr/bin/env python3
+"""Camera and IMU cost figures, printed one per line (part of ``./mbot bench``).
+
+(a) per camera size (320x240, 640x480, 1280x720) and renderer (TinyRenderer, the default; PyBullet's EGL
+    plugin on the platform's GL): the wall time of one frame of the course's kinect in the play ground
+    (render + depth linearisation + rgb8), and of the depth image and point cloud built from it;
+(b) the real-time factor of the course's camera robot (1280x720 at 30 Hz) and kinect robot (640x480 at
+    20 Hz) in the play ground with the image subscribed, each frame serialized as the ROS message;
+(c) the real-time factor of the mbot with TurtleBot3's IMU plugin at updateRate 0 (every 1 ms step, each
+    reading serialized) against the same robot without it.
+
+The machine's load changes these figures (--runs N takes the median of N runs).
+
+    PYTHONPATH=src/mbot_sim_bridge/src .venv/bin/python src/mbot_sim_bridge/bench/bench_cameras.py
+"""
+import argparse
+import io
+import os
+import statistics
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
+sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
+
+from sensor_msgs.msg import Image, Imu  # noqa: E402 (after the path set-up)
+
+from mbot_sim_bridge.core.camera import RENDERER_ENV, Camera, DepthCamera  # noqa: E402
+from mbot_sim_bridge.core.diff_drive import DiffDrive  # noqa: E402
+from mbot_sim_bridge.core.imu import ImuModelPlugin  # noqa: E402
+from mbot_sim_bridge.core.joint_states import JointStatePublisher  # noqa: E402
+from mbot_sim_bridge.core.robot_model import parse_robot  # noqa: E402
+from mbot_sim_bridge.core.sdf_world import parse_world  # noqa: E402
+from mbot_sim_bridge.core.simulation import Simulation  # noqa: E402
+
+REGISTRY = {"libgazebo_ros_diff_drive.so": DiffDrive, "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
+            "libgazebo_ros_camera.so": Camera, "libgazebo_ros_openni_kinect.so": DepthCamera,
+            "libgazebo_ros_imu.so": ImuModelPlugin}
+PLAY_GROUND = os.path.join(WORKSPACE, "src", "mbot_gazebo", "worlds", "playground.world")
+SIZES = ((320, 240), (640, 480), (1280, 720))
+# TurtleBot3 burger's IMU plugin block (turtlebot3_burger.gazebo.xacro), on a board lumped into the base.
+IMU_BLOCK = """<link name="imu_link"/>
+<joint name="imu_joint" type="fixed"><origin xyz="-0.03 0 0.07"/><parent link="base_link"/><child link="imu_link"/>
+</joint>
+<gazebo><plugin name="imu_plugin" filename="libgazebo_ros_imu.so"><alwaysOn>true</alwaysOn>
+<bodyName>imu_link</bodyName><frameName>imu_link</frameName><topicName>imu</topicName>
+<serviceName>imu_service</serviceName><gaussianNoise>0.0</gaussianNoise><updateRate>0</updateRate></plugin></gazebo>
+</robot>"""
+
+
+def course_urdf(name: str) -> str:
+    package_path = os.environ.get("ROS_PACKAGE_PATH", "")
+    os.environ["ROS_PACKAGE_PATH"] = os.path.join(WORKSPACE, "src") + os.pathsep + package_path
+    import xacro
+    path = os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo", name + ".xacro")
+    return xacro.process_file(path).toxml()
+
+
+def spawn(urdf: str):
+    sim = Simulation(parse_world(PLAY_GROUND), REGISTRY)
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot")
+    return sim, spawned
+
+
+def serialized(message) -> int:
+    buffer = io.BytesIO()
+    message.serialize(buffer)
+    return buffer.tell()
+
+
+def frame_costs(kinect_urdf: str, width: int, height: int, frames: int):
+    """Median ms of: one frame (render, rgb8), the depth image, the point cloud."""
+    urdf = kinect_urdf.replace("<width>640</width>", "<width>%d</width>" % width).replace(
+        "<height>480</height>", "<height>%d</height>" % height)
+    sim, spawned = spawn(urdf)
+    try:
+        kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
+        sim.step(100)
+        kinect.capture(sim.sim_time)
+        render, depth, cloud = [], [], []
+        for _ in range(frames):
+            start = time.perf_counter()
+            frame = kinect.capture(sim.sim_time)
+            middle = time.perf_counter()
+            kinect.depth_image(frame).tobytes()
+            after_depth = time.perf_counter()
+            kinect.cloud_data(frame)
+            render.append(middle - start)
+            depth.append(after_depth - middle)
+            cloud.append(time.perf_counter() - after_depth)
+        return (1000 * statistics.median(render), 1000 * statistics.median(depth), 1000 * statistics.median(cloud),
+                kinect.renderer.renderer)
+    finally:
+        sim.close()
+
+
+def camera_rtf(urdf: str, sim_seconds: float) -> float:
+    """Real-time factor with every frame's image built and serialized, as a subscribed topic gets it."""
+    sim, spawned = spawn(urdf)
+    try:
+        camera = next(plugin for plugin in spawned.plugins if isinstance(plugin, Camera))
+        update = camera.update
+
+        def update_and_serialize(now):
+            update(now)
+            frame = camera.latest
+            image = Image(height=frame.image.shape[0], width=frame.image.shape[1], encoding=camera.encoding,
+                          step=frame.image.strides[0], data=frame.image.tobytes())
+            serialized(image)
+
+        camera.update = update_and_serialize
+        sim.step(200)
+        start = time.perf_counter()
+        sim.step(int(round(sim_seconds / sim.step_size)))
+        return sim_seconds / (time.perf_counter() - start)
+    finally:
+        sim.close()
+
+
+def imu_rtf(urdf: str, sim_seconds: float, with_imu: bool) -> float:
+    sim, spawned = spawn(urdf.replace("</robot>", IMU_BLOCK) if with_imu else urdf)
+    try:
+        for plugin in spawned.plugins:
+            if isinstance(plugin, ImuModelPlugin):
+                update = plugin.update
+
+                def update_and_serialize(now, plugin=plugin, update=update):
+                    update(now)
+                    reading = plugin.latest
+                    message = Imu()
+                    message.orientation.x, message.orientation.y, message.orientation.z, message.orientation.w = \
+                        reading.orientation
+                    serialized(message)
+
+                plugin.update = update_and_serialize
+            if isinstance(plugin, DiffDrive):
+                plugin.set_command(0.2, 0.3)
+        sim.step(200)
+        start = time.perf_counter()
+        sim.step(int(round(sim_seconds / sim.step_size)))
+        return sim_seconds / (time.perf_counter() - start)
+    finally:
+        sim.close()
+
+
+def median_of(runs, function, *args):
+    return statistics.median(function(*args) for _ in range(runs))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=5, help="frames timed per camera size")
+    parser.add_argument("--sim-seconds", type=float, default=2.0, help="sim time of each real-time-factor run")
+    parser.add_argument("--runs", type=int, default=1, help="runs per real-time factor (median)")
+    args = parser.parse_args()
+    kinect_urdf, camera_urdf = course_urdf("mbot_with_kinect_gazebo"), course_urdf("mbot_with_camera_gazebo")
+    mbot_urdf = course_urdf("mbot_gazebo")
+    for renderer in ("tiny", "egl"):
+        os.environ[RENDERER_ENV] = renderer
+        for width, height in SIZES:
+            render, depth, cloud, used = frame_costs(kinect_urdf, width, height, args.frames)
+            print("camera frame %dx%d (%s renderer): %.1f ms render + rgb8, %.1f ms depth image, %.1f ms point "
+                  "cloud" % (width, height, used, render, depth, cloud), flush=True)
+    for renderer in ("tiny", "egl"):
+        os.environ[RENDERER_ENV] = renderer
+        print("real-time factor, course camera robot (1280x720 at 30 Hz, image subscribed, %s): %.2f"
+              % (renderer, median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds)), flush=True)
+        print("real-time factor, course kinect robot (640x480 at 20 Hz, rgb image subscribed, %s): %.2f"
+              % (renderer, median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds)), flush=True)
+    os.environ.pop(RENDERER_ENV)
+    without = median_of(args.runs, imu_rtf, mbot_urdf, args.sim_seconds, False)
+    with_imu = median_of(args.runs, imu_rtf, mbot_urdf, args.sim_seconds, True)
+    print("real-time factor, mbot without IMU: %.2f; with TurtleBot3's libgazebo_ros_imu.so at updateRate 0 "
+          "(1000 readings a sim second): %.2f" % (without, with_imu), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,70 @@
+#!/usr/bin/env python3
+"""Real-time factor of the mbot driven through ros_control beside the mbot driven by the diff-drive plugin.
+
+Each runs in the empty world at real-time factor 0 (as fast as the machine goes), headless, with
+robot_state_publisher, driving a 0.3 m/s, 0.5 rad/s circle, and every topic subscribed; the figure is sim
+seconds per wall second over the window. ros_control runs its controllers every physics step (controlPeriod
+defaults to the step, as in gazebo_ros_control); the plugin updates at its updateRate (100 Hz).
+"""
+import argparse
+import os
+import subprocess
+import time
+
+import rospy
+from geometry_msgs.msg import Twist
+from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def real_time_factor(ros_control: bool, wall_seconds: float) -> float:
+    """Launch one variant against the running master, measure, stop it."""
+    launch = subprocess.Popen(["roslaunch", os.path.join(HERE, "mbot_bench.launch"),
+                               "ros_control:=%s" % str(ros_control).lower()],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        prefix = "/mobile_base_controller" if ros_control else ""
+        rospy.wait_for_message(prefix + "/odom", Odometry, timeout=120)
+        command = rospy.Publisher(prefix + "/cmd_vel", Twist, queue_size=1)
+        twist = Twist()
+        twist.linear.x, twist.angular.z = 0.3, 0.5
+        clock = []
+        subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
+                                                                                m.clock.to_sec())))]
+        subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
+                        for topic, _ in rospy.get_published_topics() if topic != "/clock"]
+        deadline = time.monotonic() + 1.0 + wall_seconds
+        window_start = None
+        while time.monotonic() < deadline:
+            command.publish(twist)  # every 10 ms of wall time: within cmd_vel_timeout (0.5 s) at any speed here
+            time.sleep(0.01)
+            if window_start is None and time.monotonic() > deadline - wall_seconds:
+                window_start = len(clock)
+        (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
+        for subscriber in subscribers:
+            subscriber.unregister()
+        command.unregister()
+        return (sim1 - sim0) / (wall1 - wall0)
+    finally:
+        stop_process_group(launch)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each robot is measured")
+    args = parser.parse_args()
+    with PrivateMaster() as master:
+        os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
+        rospy.init_node("bench_ros_control", disable_signals=True)
+        plugin = real_time_factor(False, args.wall_seconds)
+        print("plugin-driven mbot real-time factor: %.2f" % plugin, flush=True)
+        controlled = real_time_factor(True, args.wall_seconds)
+        print("ros_control mbot real-time factor: %.2f" % controlled)
+        print("ros_control / plugin: %.2f (target >= 0.8)" % (controlled / plugin))
+
+
+if __name__ == "__main__":
+    main()

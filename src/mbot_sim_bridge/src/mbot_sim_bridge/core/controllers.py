@@ -1,0 +1,656 @@
+"""The common ros_controllers (noetic-devel), without ROS: configuration from the same parameters, the same
+maths, the same start/update behaviour. The ROS layer (``ros_control/controllers.py``) adds their topics.
+
+- joint_state_controller/JointStateController: ``publish_rate`` (required), ``joints``, ``extra_joints``;
+- diff_drive_controller/DiffDriveController: wheels as names or lists, geometry from the parameters or the URDF,
+  multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact arc /
+  Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``;
+- forward command controllers: position/velocity/effort ``Joint*Controller`` and ``JointGroup*Controller``;
+- PID controllers: effort_controllers/JointPositionController, JointVelocityController, JointGroupPositionController
+  and velocity_controllers/JointPositionController (control_toolbox's Pid from ``pid/p i d i_clamp``).
+"""
+import collections
+import math
+import threading
+from typing import Dict, List, Optional, Sequence
+
+from .log import get_logger, warn_once
+from .ros_control import (EFFORT, JOINT_STATE, POSITION, VELOCITY, ControllerInitError, LoadContext, Pid, RobotHWSim,
+                          UrdfInfo,
+                          clamp, shortest_angular_distance, shortest_angular_distance_with_limits)
+
+_logger = get_logger(__name__)
+
+_MISSING = object()
+
+
+def param(params: dict, path: str, default=_MISSING, kind: type = float, where: str = ""):
+    """A controller parameter by its slash path ("linear/x/max_velocity"), as NodeHandle::param reads it:
+    ints are accepted for doubles; a value of the wrong type keeps the default, with a warning."""
+    value = params
+    for key in path.split("/"):
+        if not isinstance(value, dict) or key not in value:
+            return None if default is _MISSING else default
+        value = value[key]
+    if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if kind is int and isinstance(value, int) and not isinstance(value, bool):
+        return value
+    if isinstance(value, kind):
+        return value
+    warn_once(_logger, "%s: parameter '%s' is %r, not a %s; using %r" % (where, path, value, kind.__name__, default))
+    return None if default is _MISSING else default
+
+
+class Controller:
+    """controller_interface::Controller<T>: the state machine and the claimed resources."""
+
+    INTERFACE = JOINT_STATE
+
+    def __init__(self, name: str, hw: RobotHWSim, params: dict, context: "LoadContext"):
+        self.name = name
+        self.hw = hw
+        self.params = params
+        self.state = "initialized"
+        self.claimed: List[str] = []
+
+    def handle(self, joint: str):
+        handle = self.hw.handle(joint, self.INTERFACE)
+        if self.INTERFACE != JOINT_STATE and joint not in self.claimed:
+            self.claimed.append(joint)
+        return handle
+
+    def start_request(self, now: float):
+        self.starting(now)
+        self.state = "running"
+
+    def stop_request(self, now: float):
+        self.stopping(now)
+        self.state = "stopped"
+
+    def starting(self, now: float):
+        pass
+
+    def stopping(self, now: float):
+        pass
+
+    def update(self, now: float, period: float):
+        pass
+
+    def publish_due(self, now: float) -> bool:
+        """Whether the ROS layer has something to publish now (the bridge publishes after /clock)."""
+        return False
+
+    def restart_clock(self, now: float):
+        """Sim time was reset: start the publish and timeout clocks again from ``now``."""
+
+    def close(self):
+        pass
+
+
+# -- joint_state_controller ----------------------------------------------------------------------------------
+class JointStateController(Controller):
+    INTERFACE = JOINT_STATE
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        names = params.get("joints")
+        self.joint_names = list(names) if isinstance(names, list) else hw.names_with(JOINT_STATE)
+        rate = param(params, "publish_rate", None, float, name)
+        if rate is None:
+            raise ControllerInitError("Parameter 'publish_rate' not set")
+        self.publish_rate = rate
+        self.joints = [self.handle(joint) for joint in self.joint_names]
+        self.extra = self._extra_joints(params.get("extra_joints"))
+        self.last_publish = None
+
+    def _extra_joints(self, specification) -> List[tuple]:
+        """(name, position, velocity, effort) of each valid ``extra_joints`` entry; bad ones logged and skipped."""
+        if specification is None:
+            return []
+        if not isinstance(specification, list):
+            _logger.error("Extra joints specification is not an array. Ignoring.")
+            return []
+        extra = []
+        for element in specification:
+            if not isinstance(element, dict):
+                _logger.error("Extra joint specification is not a struct, but rather '%s'. Ignoring.",
+                              type(element).__name__)
+                continue
+            if "name" not in element:
+                _logger.error("Extra joint does not specify name. Ignoring.")
+                continue
+            joint = str(element["name"])
+            if joint in self.joint_names or joint in [entry[0] for entry in extra]:
+                _logger.warning("Joint state interface already contains specified extra joint '%s'.", joint)
+                continue
+            values = []
+            for key, label in (("position", "position"), ("velocity", "velocity"), ("effort", "effort")):
+                value = element.get(key, 0.0)
+                if not isinstance(value, float):
+                    _logger.error("Extra joint '%s' does not specify a valid default %s. Ignoring.", joint, label)
+                    break
+                values.append(value)
+            else:
+                extra.append((joint, *values))
+        return extra
+
+    def starting(self, now):
+        if self.last_publish is None:
+            # Once only, so the rate holds through restarts; 1.001 periods back publishes on the first cycle.
+            self.last_publish = now - 1.001 / self.publish_rate if self.publish_rate > 0 else now
+
+    def restart_clock(self, now):
+        if self.last_publish is not None:
+            self.last_publish = None
+            if self.state == "running":
+                self.starting(now)
+
+    def publish_due(self, now):
+        if self.publish_rate > 0 and self.last_publish + 1.0 / self.publish_rate < now:
+            self.last_publish += 1.0 / self.publish_rate
+            return True
+        return False
+
+    def states(self):
+        """(names, positions, velocities, efforts) with the extra joints' fixed values last."""
+        names = self.joint_names + [entry[0] for entry in self.extra]
+        return (names, [j.position for j in self.joints] + [e[1] for e in self.extra],
+                [j.velocity for j in self.joints] + [e[2] for e in self.extra],
+                [j.effort for j in self.joints] + [e[3] for e in self.extra])
+
+
+# -- diff_drive_controller -----------------------------------------------------------------------------------
+class SpeedLimiter:
+    """diff_drive_controller::SpeedLimiter: jerk, then acceleration, then velocity."""
+
+    def __init__(self, has_velocity_limits=False, has_acceleration_limits=False, has_jerk_limits=False,
+                 min_velocity=0.0, max_velocity=0.0, min_acceleration=0.0, max_acceleration=0.0,
+                 min_jerk=0.0, max_jerk=0.0):
+        self.has_velocity_limits, self.has_acceleration_limits = has_velocity_limits, has_acceleration_limits
+        self.has_jerk_limits = has_jerk_limits
+        self.min_velocity, self.max_velocity = min_velocity, max_velocity
+        self.min_acceleration, self.max_acceleration = min_acceleration, max_acceleration
+        self.min_jerk, self.max_jerk = min_jerk, max_jerk
+
+    @classmethod
+    def from_params(cls, params: dict, prefix: str, where: str) -> "SpeedLimiter":
+        """``linear/x/...`` or ``angular/z/...``; the minimums default to minus the maximums, as upstream."""
+        def get(key, default, kind=float):
+            return param(params, prefix + "/" + key, default, kind, where)
+        limiter = cls(get("has_velocity_limits", False, bool), get("has_acceleration_limits", False, bool),
+                      get("has_jerk_limits", False, bool))
+        for quantity in ("velocity", "acceleration", "jerk"):
+            maximum = get("max_" + quantity, 0.0)
+            setattr(limiter, "max_" + quantity, maximum)
+            setattr(limiter, "min_" + quantity, get("min_" + quantity, -maximum))
+        return limiter
+
+    def limit(self, v: float, v0: float, v1: float, dt: float) -> float:
+        """The limited command, given the last two commands v0 (previous) and v1 (before that)."""
+        if self.has_jerk_limits:
+            dv, dv0, dt2 = v - v0, v0 - v1, 2.0 * dt * dt
+            v = v0 + dv0 + clamp(dv - dv0, self.min_jerk * dt2, self.max_jerk * dt2)
+        if self.has_acceleration_limits:
+            v = v0 + clamp(v - v0, self.min_acceleration * dt, self.max_acceleration * dt)
+        if self.has_velocity_limits:
+            v = clamp(v, self.min_velocity, self.max_velocity)
+        return v
+
+
+class DiffDriveOdometry:
+    """diff_drive_controller::Odometry: pose from wheel positions; speeds as a rolling mean over a window."""
+
+    def __init__(self, window: int = 10):
+        self.window = window
+        self.x = self.y = self.heading = 0.0
+        self.linear = self.angular = 0.0
+        self.wheel_separation = self.left_radius = self.right_radius = 0.0
+        self.left_old = self.right_old = 0.0
+        self.timestamp = 0.0
+        self.reset_accumulators()
+
+    def reset_accumulators(self):
+        self._linear = collections.deque()
+        self._angular = collections.deque()
+        self._sums = [0.0, 0.0]
+
+    def init(self, now: float):
+        self.reset_accumulators()
+        self.timestamp = now
+
+    def set_wheel_params(self, separation: float, left_radius: float, right_radius: float):
+        self.wheel_separation, self.left_radius, self.right_radius = separation, left_radius, right_radius
+
+    def update(self, left_position: float, right_position: float, now: float) -> bool:
+        left, right = left_position * self.left_radius, right_position * self.right_radius
+        left_delta, right_delta = left - self.left_old, right - self.right_old
+        self.left_old, self.right_old = left, right
+        linear = (right_delta + left_delta) * 0.5
+        angular = (right_delta - left_delta) / self.wheel_separation
+        self.integrate(linear, angular)
+        dt = now - self.timestamp
+        if dt < 0.0001:
+            return False  # too short an interval to estimate speeds
+        self.timestamp = now
+        self.linear = self._rolling_mean(self._linear, 0, linear / dt)
+        self.angular = self._rolling_mean(self._angular, 1, angular / dt)
+        return True
+
+    def _rolling_mean(self, window: collections.deque, index: int, value: float) -> float:
+        """boost's rolling_mean over the last ``window`` values, kept as a running sum."""
+        window.append(value)
+        self._sums[index] += value
+        if len(window) > self.window:
+            self._sums[index] -= window.popleft()
+        return self._sums[index] / len(window)
+
+    def update_open_loop(self, linear: float, angular: float, now: float):
+        self.linear, self.angular = linear, angular
+        dt = now - self.timestamp
+        self.timestamp = now
+        self.integrate(linear * dt, angular * dt)
+
+    def integrate(self, linear: float, angular: float):
+        """Exact arc integration, or second-order Runge-Kutta when the turn is negligible."""
+        if abs(angular) < 1e-6:
+            direction = self.heading + angular * 0.5
+            self.x += linear * math.cos(direction)
+            self.y += linear * math.sin(direction)
+            self.heading += angular
+        else:
+            heading_old = self.heading
+            radius = linear / angular
+            self.heading += angular
+            self.x += radius * (math.sin(self.heading) - math.sin(heading_old))
+            self.y += -radius * (math.cos(self.heading) - math.cos(heading_old))
+
+
+def _wheel_names(params: dict, key: str) -> List[str]:
+    value = params.get(key)
+    if value is None:
+        raise ControllerInitError("Couldn't retrieve wheel param '%s'." % key)
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, list):
+        if not value:
+            raise ControllerInitError("Wheel param '%s' is an empty list" % key)
+        for index, item in enumerate(value):
+            if not isinstance(item, str):
+                raise ControllerInitError("Wheel param '%s' #%d isn't a string." % (key, index))
+        return list(value)
+    raise ControllerInitError("Wheel param '%s' is neither a list of strings nor a string." % key)
+
+
+def _covariance_diagonal(params: dict, key: str, name: str) -> List[float]:
+    value = params.get(key)
+    if value is None:
+        return [0.0] * 6  # upstream reads an unset list as zeros
+    if (not isinstance(value, list) or len(value) != 6
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        raise ControllerInitError("%s: '%s' must be a list of 6 numbers, got %r" % (name, key, value))
+    return [float(v) for v in value]
+
+
+class DiffDriveController(Controller):
+    INTERFACE = VELOCITY
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        left, right = _wheel_names(params, "left_wheel"), _wheel_names(params, "right_wheel")
+        if len(left) != len(right):
+            raise ControllerInitError("#left wheels (%d) != #right wheels (%d)." % (len(left), len(right)))
+        self.left_names, self.right_names = left, right
+
+        def get(key, default, kind=float):
+            return param(params, key, default, kind, name)
+        self.publish_rate = get("publish_rate", 50.0)
+        self.open_loop = get("open_loop", False, bool)
+        self.wheel_separation_multiplier = get("wheel_separation_multiplier", 1.0)
+        if "wheel_radius_multiplier" in params:
+            self.left_radius_multiplier = self.right_radius_multiplier = get("wheel_radius_multiplier", 1.0)
+        else:
+            self.left_radius_multiplier = get("left_wheel_radius_multiplier", 1.0)
+            self.right_radius_multiplier = get("right_wheel_radius_multiplier", 1.0)
+        self.odometry = DiffDriveOdometry(get("velocity_rolling_window_size", 10, int))
+        self.cmd_vel_timeout = get("cmd_vel_timeout", 0.5)
+        self.allow_multiple_publishers = get("allow_multiple_cmd_vel_publishers", True, bool)
+        self.base_frame_id = get("base_frame_id", "base_link", str)
+        self.odom_frame_id = get("odom_frame_id", "odom", str)
+        self.enable_odom_tf = get("enable_odom_tf", True, bool)
+        self.limiter_linear = SpeedLimiter.from_params(params, "linear/x", name)
+        self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
+        self.publish_cmd = get("publish_cmd", False, bool)
+        if get("publish_wheel_joint_controller_state", False, bool):
+            warn_once(_logger, "%s: publish_wheel_joint_controller_state needs control_msgs, which Debian does not "
+                      "package; not published" % name)
+        self.wheel_separation = get("wheel_separation", None)
+        self.wheel_radius = get("wheel_radius", None)
+        self._geometry_from_urdf(context.urdf, left[0], right[0])
+        self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
+        self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
+        self._apply_wheel_params()
+        _logger.info("%s: Odometry params : wheel separation %s, left wheel radius %s, right wheel radius %s", name,
+                     *self.wheel_params())
+        self.left = [self.handle(joint) for joint in left]
+        self.right = [self.handle(joint) for joint in right]
+        self._lock = threading.Lock()
+        self._command = (0.0, 0.0, -math.inf)  # linear, angular, stamp (sim s)
+        self.last0 = self.last1 = (0.0, 0.0)
+        self.last_publish = 0.0
+        self.limited = (0.0, 0.0)
+
+    def _geometry_from_urdf(self, urdf: Optional[UrdfInfo], left: str, right: str):
+        if self.wheel_separation is not None and self.wheel_radius is not None:
+            return
+        if urdf is None:
+            raise ControllerInitError("Robot description couldn't be retrieved from param server.")
+        left_joint, right_joint = urdf.joints.get(left), urdf.joints.get(right)
+        for joint, joint_name in ((left_joint, left), (right_joint, right)):
+            if joint is None:
+                raise ControllerInitError("%s couldn't be retrieved from model description" % joint_name)
+        if self.wheel_separation is None:
+            self.wheel_separation = math.dist(left_joint.origin_xyz, right_joint.origin_xyz)
+        if self.wheel_radius is None:
+            collision = urdf.link_collision.get(left_joint.child)
+            if collision is None:
+                raise ControllerInitError("Link %s does not have collision description. Add collision description "
+                                          "for link to urdf.\nCouldn't retrieve %s wheel radius"
+                                          % (left_joint.child, left))
+            if collision[0] not in ("cylinder", "sphere") or collision[1] is None:
+                raise ControllerInitError("Wheel link %s is NOT modeled as a cylinder or sphere!\nCouldn't retrieve "
+                                          "%s wheel radius" % (left_joint.child, left))
+            self.wheel_radius = collision[1]
+
+    def wheel_params(self):
+        return (self.wheel_separation_multiplier * self.wheel_separation,
+                self.left_radius_multiplier * self.wheel_radius, self.right_radius_multiplier * self.wheel_radius)
+
+    def _apply_wheel_params(self):
+        self.wheel_params_applied = self.wheel_params()
+        self.odometry.set_wheel_params(*self.wheel_params_applied)
+
+    def set_command(self, linear: float, angular: float, stamp: float, publishers: int = 1) -> Optional[str]:
+        """cmdVelCallback: None when taken, else upstream's complaint (the ROS layer logs it, throttled)."""
+        if self.state != "running":
+            return "Can't accept new commands. Controller is not running."
+        if not self.allow_multiple_publishers and publishers > 1:
+            self.brake()
+            return "Detected %d publishers. Only 1 publisher is allowed. Going to brake." % publishers
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return "Received NaN in velocity command. Ignoring."
+        with self._lock:
+            self._command = (linear, angular, stamp)
+        return None
+
+    def brake(self):
+        for joint in self.left + self.right:
+            joint.command = 0.0
+
+    def starting(self, now):
+        self.brake()
+        self.last_publish = now
+        self.odometry.init(now)
+
+    def stopping(self, now):
+        self.brake()
+
+    def restart_clock(self, now):
+        self.last_publish = now
+        self.odometry.timestamp = now
+        with self._lock:
+            self._command = (0.0, 0.0, -math.inf)
+
+    def update(self, now, period):
+        # Upstream re-applies the multipliers every cycle for dynamic_reconfigure, which is not served here:
+        # they are applied once, at init.
+        if self.open_loop:
+            self.odometry.update_open_loop(self.last0[0], self.last0[1], now)
+        else:
+            count = len(self.left)
+            left = sum(joint.position for joint in self.left) / count
+            right = sum(joint.position for joint in self.right) / count
+            if math.isnan(left) or math.isnan(right):
+                return
+            self.odometry.update(left, right, now)
+        with self._lock:
+            linear, angular, stamp = self._command
+        if now - stamp > self.cmd_vel_timeout:
+            linear = angular = 0.0
+        linear = self.limiter_linear.limit(linear, self.last0[0], self.last1[0], period)
+        angular = self.limiter_angular.limit(angular, self.last0[1], self.last1[1], period)
+        self.last1, self.last0 = self.last0, (linear, angular)
+        self.limited = (linear, angular)
+        separation, left_radius, right_radius = self.wheel_params_applied
+        left_speed = (linear - angular * separation / 2.0) / left_radius
+        right_speed = (linear + angular * separation / 2.0) / right_radius
+        for joint in self.left:
+            joint.command = left_speed
+        for joint in self.right:
+            joint.command = right_speed
+
+    def publish_due(self, now):
+        if self.last_publish + 1.0 / self.publish_rate < now:
+            self.last_publish += 1.0 / self.publish_rate
+            return True
+        return False
+
+
+# -- forward command and PID controllers ---------------------------------------------------------------------
+def _joint_name(params: dict, namespace: str) -> str:
+    joint = params.get("joint")
+    if not isinstance(joint, str):
+        raise ControllerInitError("No joint given (namespace: %s)" % namespace)
+    return joint
+
+
+def _joint_names(params: dict, namespace: str) -> List[str]:
+    joints = params.get("joints")
+    if not isinstance(joints, list) or not all(isinstance(joint, str) for joint in joints):
+        raise ControllerInitError("Failed to getParam 'joints' (namespace: %s)." % namespace)
+    if not joints:
+        raise ControllerInitError("List of joint names is empty.")
+    return list(joints)
+
+
+class ForwardCommandController(Controller):
+    """forward_command_controller: ``command`` (std_msgs/Float64) goes to the joint as it is."""
+
+    START_AT_POSITION = False  # position controllers start by holding where the joint is; the others at 0
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        self.joint = self.handle(_joint_name(params, self.namespace))
+        self.command = 0.0
+
+    def set_command(self, value: float):
+        self.command = value
+
+    def starting(self, now):
+        self.command = self.joint.position if self.START_AT_POSITION else 0.0
+
+    def update(self, now, period):
+        self.joint.command = self.command
+
+
+class ForwardJointGroupCommandController(Controller):
+    """forward_joint_group_command_controller: ``command`` (std_msgs/Float64MultiArray), one value per joint."""
+
+    START_AT_POSITION = False
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        self.joint_names = _joint_names(params, self.namespace)
+        self.joints = [self._group_handle(joint) for joint in self.joint_names]
+        self.commands = [0.0] * len(self.joints)
+
+    def _group_handle(self, joint):
+        try:
+            return self.handle(joint)
+        except Exception as error:  # upstream catches HardwareInterfaceException here and fails init
+            raise ControllerInitError("Exception thrown: %s" % error) from None
+
+    def set_commands(self, values: Sequence[float]) -> Optional[str]:
+        if len(values) != len(self.joints):
+            return ("Dimension of command (%d) does not match number of joints (%d)! Not executing!"
+                    % (len(values), len(self.joints)))
+        self.commands = list(values)
+        return None
+
+    def starting(self, now):
+        self.commands = [joint.position if self.START_AT_POSITION else 0.0 for joint in self.joints]
+
+    def update(self, now, period):
+        for joint, command in zip(self.joints, self.commands):
+            joint.command = command
+
+
+def _position_error(joint_type: str, current: float, target: float, lower: float, upper: float) -> float:
+    if joint_type == "revolute":
+        return shortest_angular_distance_with_limits(current, target, lower, upper)
+    if joint_type == "continuous":
+        return shortest_angular_distance(current, target)
+    return target - current
+
+
+class _UrdfJointLimits:
+    """The URDF joint a PID position controller needs: its type and position limits."""
+
+    def __init__(self, urdf: Optional[UrdfInfo], joint: str):
+        if urdf is None:
+            raise ControllerInitError("Failed to parse urdf file")
+        urdf_joint = urdf.joints.get(joint)
+        if urdf_joint is None:
+            raise ControllerInitError("Could not find joint '%s' in urdf" % joint)
+        self.type = urdf_joint.type
+        limit = urdf_joint.limit or {}
+        self.lower, self.upper = limit.get("lower", 0.0), limit.get("upper", 0.0)
+
+    def enforce(self, command: float) -> float:
+        if self.type in ("revolute", "prismatic"):
+            if command > self.upper:
+                return self.upper
+            if command < self.lower:
+                return self.lower
+        return command
+
+
+def _pid(params: dict, key: str, namespace: str) -> Pid:
+    pid = Pid.from_params(param(params, key, None, dict), namespace + "/" + key)
+    if pid is None:
+        raise ControllerInitError("")  # Pid.from_params has said why
+    return pid
+
+
+class PidPositionController(Controller):
+    """effort_controllers/JointPositionController (INTERFACE EFFORT) and velocity_controllers/
+    JointPositionController (INTERFACE VELOCITY): PID on the position error, output as the joint's command."""
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        joint = _joint_name(params, self.namespace)
+        self.pid = _pid(params, "pid", self.namespace)
+        self.joint = self.handle(joint)
+        self.urdf = _UrdfJointLimits(context.urdf, joint)
+        self.target = 0.0
+        self.target_velocity = None
+        self.error = self.output = 0.0
+
+    def set_command(self, position: float, velocity: Optional[float] = None):
+        self.target, self.target_velocity = position, velocity
+
+    def starting(self, now):
+        self.target, self.target_velocity = self.urdf.enforce(self.joint.position), None
+        self.pid.reset()
+
+    def update(self, now, period):
+        target = self.urdf.enforce(self.target)
+        self.error = _position_error(self.urdf.type, self.joint.position, target, self.urdf.lower, self.urdf.upper)
+        velocity_error = None if self.target_velocity is None else self.target_velocity - self.joint.velocity
+        self.output = self.pid.compute(self.error, period, velocity_error)
+        self.joint.command = self.output
+
+
+class EffortVelocityController(Controller):
+    """effort_controllers/JointVelocityController: PID on the velocity error, output as effort."""
+
+    INTERFACE = EFFORT
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        self.joint = self.handle(_joint_name(params, self.namespace))
+        self.pid = _pid(params, "pid", self.namespace)
+        self.target = 0.0
+        self.error = self.output = 0.0
+
+    def set_command(self, velocity: float):
+        self.target = velocity
+
+    def starting(self, now):
+        self.target = 0.0
+        self.pid.reset()
+
+    def update(self, now, period):
+        self.error = self.target - self.joint.velocity
+        self.output = self.pid.compute(self.error, period)
+        self.joint.command = self.output
+
+
+class EffortGroupPositionController(ForwardJointGroupCommandController):
+    """effort_controllers/JointGroupPositionController: one PID per joint, from ``<joint>/pid``."""
+
+    INTERFACE = EFFORT
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.urdf = [_UrdfJointLimits(context.urdf, joint) for joint in self.joint_names]
+        self.pids = []
+        for joint in self.joint_names:
+            pid = Pid.from_params(param(params, joint + "/pid", None, dict), self.namespace + "/" + joint + "/pid")
+            if pid is None:
+                raise ControllerInitError("Failed to load PID parameters from %s/pid" % joint)
+            self.pids.append(pid)
+
+    def starting(self, now):
+        self.commands = [limits.enforce(joint.position) for joint, limits in zip(self.joints, self.urdf)]
+        for pid in self.pids:
+            pid.reset()
+
+    def update(self, now, period):
+        for joint, command, limits, pid in zip(self.joints, self.commands, self.urdf, self.pids):
+            target = limits.enforce(command)
+            joint.command = pid.compute(_position_error(limits.type, joint.position, target, limits.lower,
+                                                        limits.upper), period)
+
+
+def _forward(base: type, interface: str, start_at_position: bool, name: str) -> type:
+    return type(name, (base,), {"INTERFACE": interface, "START_AT_POSITION": start_at_position})
+
+
+# Controller type string -> core class. The ROS layer has the same keys with its subclasses.
+CORE_CONTROLLERS: Dict[str, type] = {
+    "joint_state_controller/JointStateController": JointStateController,
+    "diff_drive_controller/DiffDriveController": DiffDriveController,
+    "position_controllers/JointPositionController":
+        _forward(ForwardCommandController, POSITION, True, "PositionJointPositionController"),
+    "position_controllers/JointGroupPositionController":
+        _forward(ForwardJointGroupCommandController, POSITION, True, "PositionJointGroupPositionController"),
+    "velocity_controllers/JointVelocityController":
+        _forward(ForwardCommandController, VELOCITY, False, "VelocityJointVelocityController"),
+    "velocity_controllers/JointGroupVelocityController":
+        _forward(ForwardJointGroupCommandController, VELOCITY, False, "VelocityJointGroupVelocityController"),
+    "velocity_controllers/JointPositionController":
+        type("VelocityJointPositionController", (PidPositionController,), {"INTERFACE": VELOCITY}),
+    "effort_controllers/JointEffortController":
+        _forward(ForwardCommandController, EFFORT, False, "EffortJointEffortController"),
+    "effort_controllers/JointGroupEffortController":
+        _forward(ForwardJointGroupCommandController, EFFORT, False, "EffortJointGroupEffortController"),
+    "effort_controllers/JointPositionController":
+        type("EffortJointPositionController", (PidPositionController,), {"INTERFACE": EFFORT}),
+    "effort_controllers/JointVelocityController": EffortVelocityController,
+    "effort_controllers/JointGroupPositionController": EffortGroupPositionController,
+}

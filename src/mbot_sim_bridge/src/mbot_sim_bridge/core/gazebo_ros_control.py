@@ -1,0 +1,158 @@
+"""``libgazebo_ros_control.so`` without ROS: the tags, the default robot hardware simulation and the controller
+manager, updated at ``controlPeriod`` in the loop thread.
+
+As gazebo_ros_control's GazeboRosControlPlugin (Noetic): the controllers update when at least controlPeriod
+(default: the physics step) has passed since the last update, reading the joints first; the joint commands
+are written after every physics step. The ROS plugin (``plugins/gazebo_ros_control.py``) supplies the URDF
+from ``robotParam``, the parameters, the controllers' ROS classes and the services.
+
+The controllers' messages are published from ``update(now)``, which the Simulation calls after /clock
+(``timer`` is due whenever a running controller's publish time has come), so none is stamped ahead of the
+clock; their control runs in ``on_step``.
+"""
+from typing import Dict, List, Optional
+
+from .controllers import CORE_CONTROLLERS
+from .log import get_logger, warn_once
+from .params import Param
+from .plugin import Plugin
+from .robot_model import parse_robot
+from .ros_control import ControllerManager, RobotHWSim, UrdfInfo, parse_transmissions
+from .xml_values import XmlDocument
+
+_logger = get_logger(__name__)
+
+DEFAULT_ROBOT_HW_SIM = "gazebo_ros_control/DefaultRobotHWSim"
+# controlPeriod equal to the step, to within this, counts as the step (sim time is a multiple of it).
+_EPSILON = 1e-9
+
+GAZEBO_ROS_CONTROL_PARAMS = (
+    Param("robotNamespace", str, "", "namespace of the controller manager, its controllers and parameters; "
+          "spawn_model sets it", warn_if_missing=False),
+    Param("robotParam", str, "robot_description", "parameter holding the URDF (searched up from robotNamespace)",
+          warn_if_missing=False),
+    Param("controlPeriod", float, 0.0, "controller update period (s); absent = the physics step",
+          warn_if_missing=False, minimum=0.0),
+    Param("robotSimType", str, DEFAULT_ROBOT_HW_SIM, "robot hardware simulation; only the default one",
+          warn_if_missing=False, choices=(DEFAULT_ROBOT_HW_SIM,)),
+    Param("legacyModeNS", bool, False, "Kinetic's absolute /gazebo_ros_control/pid_gains namespace when true "
+          "(see README)", warn_if_missing=False),
+    Param("eStopTopic", str, "", "std_msgs/Bool topic: true stops every joint, false restarts the controllers",
+          warn_if_missing=False),
+)
+
+
+class _PublishSchedule:
+    """The plugin's ``timer``: due when any running controller has something to publish."""
+
+    def __init__(self, plugin: "RosControl"):
+        self.plugin = plugin
+
+    def due(self, now: float) -> bool:
+        due = [loaded for loaded in self.plugin.manager.controllers
+               if loaded.controller.state == "running" and loaded.controller.publish_due(now)]
+        self.plugin.publish_now = due
+        return bool(due)
+
+    def steps_until_due(self, now: float, step_size: float) -> int:
+        return 1  # the plugin steps with the physics anyway (needs_every_step)
+
+    def reset(self, now: float):
+        pass
+
+
+class RosControl(Plugin):
+    GAZEBO_CLASS = "GazeboRosControlPlugin"
+    PARAMS = GAZEBO_ROS_CONTROL_PARAMS
+    needs_every_step = True
+
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        params = self.read_params()
+        self.params = params
+        # Absent or empty: the model name, as gazebo_ros_control (spawn_model always sets it).
+        # A relative one is relative to the simulator's node, which lives at the root.
+        self.namespace = "/" + (params["robotNamespace"] or context.model.name).lstrip("/")
+        step = context.simulation.step_size
+        self.control_period = params["controlPeriod"] if self.element.find("controlPeriod") is not None else step
+        if self.control_period < step - _EPSILON:
+            _logger.error("%s: Desired controller update period (%s s) is faster than the gazebo simulation period "
+                          "(%s s).", self.label, self.control_period, step)
+        elif self.control_period > step + _EPSILON:
+            _logger.warning("%s: Desired controller update period (%s s) is slower than the gazebo simulation "
+                            "period (%s s).", self.label, self.control_period, step)
+        urdf_text, source = self.robot_description(params["robotParam"])
+        model = parse_robot(urdf_text, source) if urdf_text is not None else context.robot.model
+        document: XmlDocument = model.document
+        transmissions = parse_transmissions(document.root, document.where)
+        self.urdf = UrdfInfo.from_model(model)
+        # Noetic reads the PID gains under the robot namespace; Kinetic's legacyModeNS (true, or absent there)
+        # read them at the root. A present legacyModeNS is honoured with its Kinetic meaning.
+        # Parameter names are absolute: a relative robotNamespace is relative to the simulator's node ("/").
+        base = "/" + self.namespace.strip("/") if self.namespace.strip("/") else ""
+        pid_namespace = ("" if params["legacyModeNS"] else base) + "/gazebo_ros_control/pid_gains"
+        self.hw = RobotHWSim(context.robot, transmissions, self.urdf, self.label,
+                             self.ros_param(base + "/joint_limits"), self.ros_param(pid_namespace), pid_namespace)
+        if not self.hw.joints:
+            warn_once(_logger, "%s: the robot has no usable <transmission>; the controller manager has no joints"
+                      % self.label)
+        self.driven_joints = tuple(self.hw.names)
+        self.joint_states_published = tuple(self.hw.names)
+        self.manager = ControllerManager(self.hw, self.controller_class, sorted(CORE_CONTROLLERS),
+                                         self.controller_params, self.namespace,
+                                         lambda: context.simulation.sim_time)
+        self.timer = _PublishSchedule(self)
+        self.publish_now: List = []
+        now = context.simulation.sim_time
+        self.last_update = self.last_write = now
+        self.e_stop = False
+        self._last_e_stop = False
+
+    # -- hooks the ROS plugin overrides ----------------------------------------------------------------------
+    def robot_description(self, param_name: str):
+        """(URDF text, where it came from), or (None, "") to use the spawned model's own description."""
+        return None, ""
+
+    def ros_param(self, name: str) -> Optional[dict]:
+        return None
+
+    def controller_params(self, name: str) -> Optional[Dict]:
+        return None
+
+    def controller_class(self, controller_type: str) -> Optional[type]:
+        return CORE_CONTROLLERS.get(controller_type)
+
+    # -- loop ------------------------------------------------------------------------------------------------
+    def load_controller(self, name: str) -> bool:
+        return self.manager.load(name, self.urdf)
+
+    def on_step(self, step_size: float):
+        now = self.context.simulation.sim_time
+        self.hw.e_stop_active = self.e_stop
+        period = now - self.last_update
+        if period >= self.control_period - _EPSILON:
+            self.last_update = now
+            self.hw.read()
+            reset = False
+            if self.e_stop:
+                self._last_e_stop = True
+            elif self._last_e_stop:
+                reset, self._last_e_stop = True, False
+            self.manager.update(now, period, reset)
+        self.hw.write(now - self.last_write)
+        self.last_write = now
+
+    def update(self, now: float):
+        """Publish for the controllers whose time has come (the ROS plugin does the publishing)."""
+        self.publish_now = []
+
+    def reset(self, now: float):
+        # gazebo_ros_control resets its update times; the controllers' own clocks restart too, so a
+        # reset_simulation (sim time back to 0) does not silence their topics until the old time comes back.
+        self.last_update = self.last_write = now
+        self.hw.forget_motors()
+        for loaded in self.manager.controllers:
+            loaded.controller.restart_clock(now)
+
+    def close(self):
+        self.manager.unload_all()

@@ -1,0 +1,149 @@
+"""``libgazebo_ros_control.so``: the controller manager's services, the controllers' topics, the e-stop.
+
+Services (under ``<robotNamespace>/controller_manager/``) run in rospy's threads and are serialized, as
+upstream's; load and unload work there, a switch is performed by the next control update in the loop thread
+and waited for (so it waits while the simulation is paused, as in Gazebo).
+"""
+import threading
+
+import rospy
+from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
+from controller_manager_msgs.srv import (ListControllers, ListControllersResponse, ListControllerTypes,
+                                         ListControllerTypesResponse, LoadController, LoadControllerResponse,
+                                         ReloadControllerLibraries, ReloadControllerLibrariesResponse,
+                                         SwitchController, SwitchControllerResponse, UnloadController,
+                                         UnloadControllerResponse)
+from std_msgs.msg import Bool
+
+from ..core.gazebo_ros_control import RosControl
+from ..subscriptions import TrackedSubscriber
+from . import resolve_in_namespace, ros_time
+from .ros_controllers import ROS_CONTROLLERS
+
+_BASE_CLASS = "controller_interface::ControllerBase"
+
+
+class GazeboRosControl(RosControl):
+    def __init__(self, context, element, sensor=None):
+        self._services_lock = threading.Lock()
+        super().__init__(context, element, sensor)
+        self.manager.types = sorted(ROS_CONTROLLERS)
+        prefix = resolve_in_namespace(self.namespace, "controller_manager") + "/"
+        self.e_stop_subscriber = None
+        if self.params["eStopTopic"]:
+            self.e_stop_subscriber = TrackedSubscriber(resolve_in_namespace(self.namespace, self.params["eStopTopic"]),
+                                                       Bool, self._on_e_stop)
+        handlers = (("list_controllers", ListControllers, self._list_controllers),
+                    ("list_controller_types", ListControllerTypes, self._list_controller_types),
+                    ("load_controller", LoadController, self._load_controller),
+                    ("unload_controller", UnloadController, self._unload_controller),
+                    ("switch_controller", SwitchController, self._switch_controller),
+                    ("reload_controller_libraries", ReloadControllerLibraries, self._reload_libraries))
+        self.services = [rospy.Service(prefix + name, service_type, self._serialized(handler))
+                         for name, service_type, handler in handlers]
+        rospy.loginfo("%s: controller manager in namespace %s: %d joints (%s), control period %.4f s",
+                      self.label, self.namespace, len(self.hw.joints),
+                      ", ".join("%s: %s" % (name, joint.interface) for name, joint in self.hw.joints.items()),
+                      self.control_period)
+
+    # -- hooks -------------------------------------------------------------------------------------------
+    def robot_description(self, param_name):
+        """The URDF in ``robotParam``, searched from the robot namespace upwards as NodeHandle::searchParam."""
+        namespace = self.namespace.strip("/")
+        parts = namespace.split("/") if namespace else []
+        for depth in range(len(parts), -1, -1):
+            name = "/" + "/".join(parts[:depth] + [param_name.lstrip("/")])
+            if param_name.startswith("/"):
+                name = param_name
+            if rospy.has_param(name):
+                return rospy.get_param(name), "parameter %s" % name
+        rospy.logwarn("%s: no parameter '%s' from namespace %s upwards (gazebo_ros_control would wait for it); "
+                      "using the description the model was spawned from", self.label, param_name, self.namespace)
+        return None, ""
+
+    def ros_param(self, name):
+        return rospy.get_param(name, None)
+
+    def controller_params(self, name):
+        return rospy.get_param(resolve_in_namespace(self.namespace, name), None)
+
+    def controller_class(self, controller_type):
+        return ROS_CONTROLLERS.get(controller_type)
+
+    # -- topics ------------------------------------------------------------------------------------------
+    def _on_e_stop(self, message: Bool):
+        self.e_stop = message.data
+
+    def update(self, now):
+        stamp = ros_time(now)
+        for loaded in self.publish_now:
+            loaded.controller.publish(stamp)
+        super().update(now)
+
+    # -- services ----------------------------------------------------------------------------------------
+    def _serialized(self, handler):
+        def serve(request):
+            with self._services_lock:
+                return handler(request)
+        return serve
+
+    def _list_controllers(self, request):
+        states = []
+        for loaded in self.manager.list():
+            resources = [HardwareInterfaceResources(interface, list(names)) for interface, names in loaded.claimed]
+            states.append(ControllerState(loaded.name, loaded.state, loaded.type, resources))
+        return ListControllersResponse(states)
+
+    def _list_controller_types(self, request):
+        return ListControllerTypesResponse(self.manager.types, [_BASE_CLASS] * len(self.manager.types))
+
+    def _load_controller(self, request):
+        return LoadControllerResponse(self.load_controller(request.name))
+
+    def _unload_controller(self, request):
+        return UnloadControllerResponse(self.manager.unload(request.name))
+
+    def _switch_controller(self, request):
+        return SwitchControllerResponse(self._switch(request.start_controllers, request.stop_controllers,
+                                                     request.strictness, request.start_asap, request.timeout))
+
+    def _switch(self, start, stop, strictness, start_asap=False, timeout=0.0):
+        return self.manager.switch(start, stop, strictness, start_asap, timeout, self._wait)
+
+    @staticmethod
+    def _wait(done: threading.Event, timeout: float) -> bool:
+        """Upstream waits for the realtime loop for timeout + 1 s of wall time, or for ever when timeout is 0."""
+        limit = timeout + 1.0 if timeout > 0 else None
+        waited = 0.0
+        while not done.wait(0.1):
+            waited += 0.1
+            if rospy.is_shutdown() or (limit is not None and waited >= limit):
+                return False
+        return True
+
+    def _reload_libraries(self, request):
+        names = [loaded.name for loaded in self.manager.list()]
+        if names and not request.force_kill:
+            rospy.logerr("Controller manager: Cannot reload controller libraries because there are still %i "
+                         "controllers running", len(names))
+            return ReloadControllerLibrariesResponse(False)
+        if names:
+            rospy.loginfo("Controller manager: Killing all running controllers")
+            if not self._switch([], names, 1):
+                rospy.logerr("Controller manager: Cannot reload controller libraries because failed to stop running "
+                             "controllers")
+                return ReloadControllerLibrariesResponse(False)
+            for name in names:
+                if not self.manager.unload(name):
+                    rospy.logerr("Controller manager: Cannot reload controller libraries because failed to unload "
+                                 "controller '%s'", name)
+                    return ReloadControllerLibrariesResponse(False)
+        rospy.loginfo("Controller manager: reloaded controller libraries for 'controller_interface'")
+        return ReloadControllerLibrariesResponse(True)
+
+    def close(self):
+        for service in self.services:
+            service.shutdown()
+        if self.e_stop_subscriber is not None:
+            self.e_stop_subscriber.unregister()
+        super().close()

@@ -1,0 +1,29 @@
+"""``libgazebo_ros_imu_sensor.so``: sensor_msgs/Imu of a ``<sensor type="imu">``."""
+import rospy
+from sensor_msgs.msg import Imu
+
+from ..core.imu import ImuSensor
+from . import loop_publisher, resolve_in_namespace
+from .gazebo_ros_imu import imu_message
+
+
+class GazeboRosImuSensor(ImuSensor):
+    def __init__(self, context, element, sensor):
+        super().__init__(context, element, sensor)
+        # Absent robotNamespace: "/MODEL/" (this plugin's own rule, unlike the other sensor plugins).
+        namespace = self.params["robotNamespace"]
+        namespace = "/" + context.model.name if namespace is None else (namespace or "/")
+        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
+        rospy.loginfo("%s: sensor '%s' on link '%s' -> %s (frame '%s') at %s", self.label, sensor.get("name"),
+                      self.link, self.publisher.resolved_name, self.params["frameName"],
+                      "every physics step" if self.timer.period == 0 else "%g Hz" % (1.0 / self.timer.period))
+
+    def update(self, now: float):
+        if self.publisher.get_num_connections() == 0:
+            self.difference.reset(self._point_velocity(), now)
+            return
+        super().update(now)
+        self.publisher.publish(imu_message(self.latest, self.params["frameName"]))
+
+    def close(self):
+        self.publisher.unregister()

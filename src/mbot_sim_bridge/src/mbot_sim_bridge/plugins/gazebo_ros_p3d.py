@@ -1,0 +1,41 @@
+"""``libgazebo_ros_p3d.so``: ground-truth nav_msgs/Odometry of a link."""
+import rospy
+from nav_msgs.msg import Odometry
+
+from ..core.p3d import P3D
+from . import loop_publisher, resolve_in_namespace, ros_time
+
+
+class GazeboRosP3D(P3D):
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        namespace = self.params["robotNamespace"] or "/"
+        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Odometry)
+        rospy.loginfo("%s: link '%s' -> %s in frame '%s' %s", self.label, self.body, self.publisher.resolved_name,
+                      self.frame_name, "at every physics step" if not self.params["updateRate"]
+                      else "at %g Hz" % self.params["updateRate"])
+
+    def update(self, now: float):
+        listened = self.publisher.get_num_connections() > 0
+        self.idle(not listened)
+        if not listened:
+            return
+        super().update(now)
+        truth = self.latest
+        message = Odometry()
+        message.header.stamp = ros_time(now)
+        message.header.frame_id = self.frame_name
+        message.child_frame_id = self.child_frame
+        pose, twist = message.pose.pose, message.twist.twist
+        pose.position.x, pose.position.y, pose.position.z = truth.pose.position
+        o = pose.orientation
+        o.x, o.y, o.z, o.w = truth.pose.orientation
+        twist.linear.x, twist.linear.y, twist.linear.z = truth.linear
+        twist.angular.x, twist.angular.y, twist.angular.z = truth.angular
+        covariance = [0.0] * 36
+        covariance[0::7] = [truth.covariance] * 6
+        message.pose.covariance = message.twist.covariance = covariance
+        self.publisher.publish(message)
+
+    def close(self):
+        self.publisher.unregister()

@@ -1,0 +1,223 @@
+"""core/camera.py against known geometry: K and P as Gazebo computes them, a coloured box where K says, a wall
+at a known distance in the depth image and the cloud, lazy frames and the renderers' agreement."""
+import math
+import os
+
+import numpy as np
+import pybullet
+import pytest
+
+from mbot_sim_bridge.core.camera import (
+    Camera, CameraConfig, DepthCamera, Intrinsics, camera_intrinsics, convert_image, depth_16uc1,
+    depth_in_range, image_encoding, linear_depth, point_cloud)
+from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rotation_matrix
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sdf_world import parse_world
+
+from sensor_fixtures import box, course_urdf, plugin_of, world_simulation
+
+
+@pytest.fixture(scope="module")
+def kinect_urdf():
+    return course_urdf("mbot_with_kinect_gazebo")
+
+
+@pytest.fixture(scope="module")
+def camera_urdf():
+    return course_urdf("mbot_with_camera_gazebo")
+
+
+def test_intrinsics_of_the_course_camera_and_kinect_match_gazebo():
+    camera = camera_intrinsics(CameraConfig("c", "l", 1280, 720, 1.3962634), {"hackBaseline": 0.07})
+    kinect = camera_intrinsics(CameraConfig("k", "l", 640, 480, math.radians(60)), {})
+    print(f"figure: course camera f = {camera.f:.2f} c = ({camera.cx}, {camera.cy}); "
+          f"kinect f = {kinect.f:.2f} c = ({kinect.cx}, {kinect.cy})")
+    assert camera.f == pytest.approx(762.72, abs=0.01) and (camera.cx, camera.cy) == (640.5, 360.5)
+    assert kinect.f == pytest.approx(554.26, abs=0.01) and (kinect.cx, kinect.cy) == (320.5, 240.5)
+    assert camera.K == (camera.f, 0, 640.5, 0, camera.f, 360.5, 0, 0, 1)
+    assert camera.P[3] == pytest.approx(-camera.f * 0.07) and camera.P[10] == 1.0
+    assert Intrinsics.distortion_model == "plumb_bob"
+
+
+def test_formats_map_to_gazebo_encodings_and_unknown_is_bgr8():
+    assert image_encoding("R8G8B8") == ("rgb8", 3, True)
+    assert image_encoding("L8") == ("mono8", 1, True)
+    assert image_encoding("BAYER_RGGB8") == ("bayer_rggb8", 1, True)
+    assert image_encoding("RGB8B8") == ("bgr8", 3, False)
+    rgb = np.array([[[10, 20, 30], [40, 50, 60]], [[70, 80, 90], [100, 110, 120]]], dtype=np.uint8)
+    assert convert_image(rgb, "bgr8")[0, 0].tolist() == [30, 20, 10]
+    assert convert_image(rgb, "rgb16")[0, 0].tolist() == [10 * 257, 20 * 257, 30 * 257]
+    assert convert_image(rgb, "bayer_rggb8")[..., 0].tolist() == [[10, 50], [80, 120]]
+    assert convert_image(rgb, "mono8").shape == (2, 2, 1)
+
+
+def test_depth_linearisation_ranges_and_16uc1():
+    near, far = 0.05, 8.0
+    z = np.array([0.5, 1.5, 7.0], dtype=np.float32)
+    buffer = (far - far * near / z) / (far - near)  # the OpenGL depth buffer of these z
+    depth = linear_depth(np.append(buffer, 1.0), near, far)
+    assert depth[:3] == pytest.approx(z, rel=1e-5) and depth[3] == np.inf
+    ranged = depth_in_range(depth, 0.4, 5.0)
+    assert np.isnan(ranged[2:]).all() and ranged[0] == pytest.approx(0.5, rel=1e-5)
+    assert depth_16uc1(ranged).tolist() == [500, 1500, 0, 0] or depth_16uc1(ranged).tolist()[2:] == [0, 0]
+
+
+def test_point_cloud_layout_and_geometry():
+    depth = np.full((3, 4), 2.0, dtype=np.float32)
+    depth[0, 0] = np.nan
+    rgb = np.zeros((3, 4, 3), dtype=np.uint8)
+    rgb[1, 2] = (200, 100, 50)
+    data, dense = point_cloud(depth, math.radians(60), rgb)
+    points = np.frombuffer(data, dtype=np.float32).reshape(3, 4, 8)
+    f = 4 / (2 * math.tan(math.radians(30)))
+    assert not dense and np.isnan(points[0, 0, :3]).all()
+    assert points[1, 2, :3] == pytest.approx([2 * (2 - 1.5) / f, 2 * (1 - 1.0) / f, 2.0])
+    assert np.frombuffer(data, dtype=np.uint8).reshape(3, 4, 32)[1, 2, 16:19].tolist() == [200, 100, 50]
+
+
+def test_bad_camera_values_are_refused_with_the_tag(kinect_urdf, tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        bad = kinect_urdf.replace("<far>8.0</far>", "<far>0.01</far>")
+        with pytest.raises(ConfigError, match="<clip><far>"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        bad = kinect_urdf.replace("<width>640</width>", "<width>-3</width>")
+        with pytest.raises(ConfigError, match="camera/image/width"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        assert "mbot" not in sim.model_names()
+    finally:
+        sim.close()
+
+
+def _optical_point(camera_pose, point):
+    """A world point in the camera's optical frame (z forward, x right, y down)."""
+    rotation = np.asarray(rotation_matrix(camera_pose.orientation))
+    local = rotation.T @ (np.asarray(point) - np.asarray(camera_pose.position))
+    return np.array([-local[1], -local[2], local[0]])
+
+
+def test_a_red_box_appears_where_camera_info_predicts(camera_urdf, tmp_path):
+    centre = (2.5, 0.4, 0.3)  # a thin red plate facing the camera, so only its front face shows
+    sim = world_simulation(tmp_path, box("red_box", centre, (0.01, 0.12, 0.12), (1, 0, 0)))
+    try:
+        spawned = sim.spawn_robot(parse_robot(camera_urdf, "model 'mbot'"), "mbot")
+        camera = plugin_of(spawned, Camera)
+        sim.step(200)
+        frame = camera.capture(sim.sim_time)
+        image = frame.image
+        red = (image[..., 0] > 150) & (image[..., 1] < 80) & (image[..., 2] < 80)
+        rows, cols = np.nonzero(red)
+        # The plate's near face is what the camera sees; its centre is what K projects.
+        pose = camera.sensor_pose()
+        x, y, z = _optical_point(pose, (centre[0] - 0.005, centre[1], centre[2]))
+        k = camera.intrinsics
+        predicted = (k.f * x / z + k.cx, k.f * y / z + k.cy)
+        seen = (cols.mean(), rows.mean())
+        error = math.hypot(seen[0] - predicted[0], seen[1] - predicted[1])
+        print(f"figure: red box centre predicted by K at ({predicted[0]:.1f}, {predicted[1]:.1f}) px, seen at "
+              f"({seen[0]:.1f}, {seen[1]:.1f}) px: {error:.2f} px apart ({red.sum()} red pixels, "
+              f"{camera.renderer.renderer} renderer)")
+        assert red.sum() > 50
+        assert error < 2.0
+        assert camera.encoding == "rgb8" and image.shape == (720, 1280, 3)
+    finally:
+        sim.close()
+
+
+def test_a_wall_at_1_5_m_in_the_depth_image_and_the_cloud(kinect_urdf, tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        spawned = sim.spawn_robot(parse_robot(kinect_urdf, "model 'mbot'"), "mbot")
+        kinect = plugin_of(spawned, DepthCamera)
+        sim.step(100)
+        optical = spawned.robot.link_world_pose("kinect_frame_optical")  # frameName, as TF would give it
+        wall_x = optical.position[0] + 1.5
+        sim.add_world(world_simulation_description(tmp_path, box("wall", (wall_x + 0.05, 0, 1.0), (0.1, 4, 2))))
+        frame = kinect.capture(sim.sim_time)
+        depth = kinect.depth_image(frame)
+        height, width = depth.shape
+        centre = depth[height // 2 - 20:height // 2 + 20, width // 2 - 20:width // 2 + 20]
+        data, _ = kinect.cloud_data(frame)
+        points = np.frombuffer(data, dtype=np.float32).reshape(height, width, 8)[..., :3].reshape(-1, 3)
+        points = points[np.isfinite(points).all(axis=1)]
+        rotation = np.asarray(rotation_matrix(optical.orientation))
+        world = points @ rotation.T + np.asarray(optical.position)
+        on_wall = world[(np.abs(world[:, 0] - wall_x) < 0.1) & (world[:, 2] > 0.02)]  # not the floor
+        worst = np.abs(on_wall[:, 0] - wall_x).max()
+        print(f"figure: wall at 1.5 m reads {np.nanmin(centre):.4f}..{np.nanmax(centre):.4f} m over the image "
+              f"centre; {len(on_wall)} cloud points on it lie within {worst * 1000:.2f} mm of the wall plane "
+              f"in the world (frame kinect_frame_optical)")
+        assert np.nanmax(np.abs(centre - 1.5)) < 0.01
+        assert worst < 0.01
+        assert len(on_wall) > 0.3 * height * width
+        assert np.abs(on_wall[:, 1]).max() < 2.0 and on_wall[:, 2].max() < 2.0  # within the wall's extent
+        # Nothing beyond the far clip or the cutoff max is a number.
+        assert np.isnan(depth[0, 0]) or depth[0, 0] < 5.0
+    finally:
+        sim.close()
+
+
+def world_simulation_description(tmp_path, *models):
+    """A WorldDescription holding ``models`` (spawn_sdf_model's way of adding them)."""
+    path = os.path.join(str(tmp_path), "added.world")
+    with open(path, "w") as world:
+        world.write("<?xml version='1.0'?><sdf version='1.6'><world name='w'>%s</world></sdf>" % "".join(models))
+    return parse_world(path)
+
+
+def test_frames_follow_the_sensor_rate_and_the_depth_plugin_renders_once_per_frame(kinect_urdf, tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        spawned = sim.spawn_robot(parse_robot(kinect_urdf, "model 'mbot'"), "mbot")
+        kinect = plugin_of(spawned, DepthCamera)
+        renders = []
+        original = kinect.renderer.render
+        kinect.renderer.render = lambda pose: renders.append(pose) or original(pose)
+        sim.step(1000)
+        assert kinect.frame_rate == 20.0
+        assert len(renders) == 20  # one render a frame gives the image, the depth and the cloud
+        assert kinect.latest.depth is not None and kinect.latest.stamp == pytest.approx(1.0)
+    finally:
+        sim.close()
+
+
+def test_tinyrenderer_is_the_default_and_egl_is_measured_against_it(tmp_path, monkeypatch):
+    """TinyRenderer is kept because the EGL renderer does not put things where CameraInfo says; the figures
+    show by how much (a box at a known place, 640x480)."""
+    from mbot_sim_bridge.core.camera import CameraRenderer
+    config = CameraConfig("c", "l", 640, 480, math.radians(60), near=0.05, far=8.0)
+    k = camera_intrinsics(config, {})
+    centre = (2.0, 0.6, 0.9)  # seen from (0, 0, 0.5) looking along +x
+    predicted = (k.f * -centre[1] / 2.0 + k.cx - 1, k.f * -(centre[2] - 0.5) / 2.0 + k.cy - 1)  # 0-based
+    errors = {}
+    for renderer in ("tiny", "egl"):
+        monkeypatch.setenv("MBOT_CAMERA_RENDERER", renderer)
+        client = pybullet_client()
+        try:
+            camera = CameraRenderer(client, config)  # before the body: the EGL plugin sees only later bodies
+            visual = client.createVisualShape(pybullet.GEOM_BOX, halfExtents=[0.001, 0.05, 0.05],
+                                              rgbaColor=[0, 0, 1, 1])
+            client.createMultiBody(0, -1, visual, centre)
+            rgb, depth = camera.render(pose_from_xyz_rpy((0, 0, 0.5), (0, 0, 0)))
+            rows, cols = np.nonzero(np.isfinite(depth))
+            errors[camera.renderer] = (cols.mean() - predicted[0], rows.mean() - predicted[1],
+                                       float(np.nanmin(depth)))
+        finally:
+            client.disconnect()
+    for name, (du, dv, z) in errors.items():
+        print(f"figure: {name} renderer: plate centre {du:+.2f}, {dv:+.2f} px from the 0-based K projection, "
+              f"depth {z:.4f} m (true 1.999)")
+    assert abs(errors["tiny"][0]) < 1.0 and abs(errors["tiny"][1]) < 1.0
+    assert errors["tiny"][2] == pytest.approx(1.999, abs=0.002)
+    monkeypatch.delenv("MBOT_CAMERA_RENDERER")
+    client = pybullet_client()
+    try:
+        assert CameraRenderer(client, config).renderer == "tiny"
+    finally:
+        client.disconnect()
+
+
+def pybullet_client():
+    from pybullet_utils.bullet_client import BulletClient
+    return BulletClient(connection_mode=pybullet.DIRECT)

@@ -1,0 +1,430 @@
+"""Fuzzing the core with Hypothesis: malformed robot descriptions and worlds (mutations of the shipped ones) and
+garbage service-like requests. Each case must be loaded, or refused with one line (a BridgeError without a
+newline); never another exception, a hang, a plugin that fails while stepping, or a NaN state.
+
+Hypothesis runs with a fixed seed and no example database; the outcome counts are printed as "figure:" lines.
+"""
+import copy
+import logging
+import math
+import os
+import resource
+import signal
+import tempfile
+from collections import Counter
+from contextlib import contextmanager
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.errors import BridgeError
+from mbot_sim_bridge.core.geometry import Pose
+from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.lidar import RaySensor
+from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.simulation import Simulation
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORLDS = os.path.join(HERE, "..", "..", "..", "..", "worlds")
+TEST_WORLDS = os.path.join(HERE, "..", "worlds")
+CORE_REGISTRY = {
+    "libgazebo_ros_diff_drive.so": DiffDrive,
+    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
+    "libgazebo_ros_laser.so": RaySensor,
+}
+# One case may take this long (a spawn, a world load, a few hundred steps) before it counts as a hang.
+CASE_SECONDS = 10.0
+STEPS = 200
+MEMORY_LIMIT_BYTES = 6 << 30
+FUZZ = settings(derandomize=True, deadline=None, database=None, print_blob=True,
+                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                       HealthCheck.function_scoped_fixture])
+
+BAD_NUMBERS = ("nan", "NaN", "-nan", "inf", "-inf", "1e309", "-1e309", "1e300", "-1e300", "1e-300", "0", "-0",
+               "-1", "-1000", "1e5", "1e12", "99999999999999999999", "0x10", "abc", "", " ", "1 2 3", "true")
+BAD_VECTORS = ("nan 0 0", "0 0 inf", "1e300 0 0", "0 0", "1 2 3 4 5 6 7", "-1 -1 -1", "0 0 0", "a b c",
+               "1e-300 1e-300 1e-300", "nan 0 1 0 0 0", "0 0 0 0 0 1e300")
+MESHES = ("/nonexistent/mesh.stl", "/dev/null", "/tmp", "meshes/relative.stl", "package://nowhere/m.stl",
+          "http://example.invalid/m.stl", "file:///nonexistent.dae", "model://nowhere/mesh.dae")
+
+# Elements whose text names another element or a file.
+REFERENCE_TAGS = ("leftJoint", "rightJoint", "jointName", "uri", "relative_to", "frameName", "bodyName")
+
+OUTCOMES = {}
+
+
+class Hang(Exception):
+    pass
+
+
+@contextmanager
+def watchdog(seconds=CASE_SECONDS):
+    """Interrupts a case that blocks (a FIFO read, an endless loop in Python) by raising Hang."""
+    def expire(*_):
+        raise Hang("case did not finish within %.0f s" % seconds)
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def tally(kind, outcome):
+    OUTCOMES.setdefault(kind, Counter())[outcome] += 1
+
+
+def refused(kind, error):
+    message = str(error)
+    assert message and "\n" not in message, "a refusal must be one line: %r" % message
+    tally(kind, "refused (%s)" % type(error).__name__)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def print_outcomes(request):
+    # A case that asks for absurd memory fails here with MemoryError instead of starving the machine.
+    limits = resource.getrlimit(resource.RLIMIT_AS)
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, limits[1]))
+    # The mbot's <rosDebugLevel>Debug</rosDebugLevel> sets the bridge's log level, for the tests after these too.
+    bridge_logger = logging.getLogger("rosout.mbot_sim_bridge")
+    level = bridge_logger.level
+    yield
+    bridge_logger.setLevel(level)
+    resource.setrlimit(resource.RLIMIT_AS, limits)
+    capture = request.config.pluginmanager.getplugin("capturemanager")
+    with capture.global_and_fixture_disabled():
+        for kind, counts in OUTCOMES.items():
+            details = ", ".join("%d %s" % (count, outcome) for outcome, count in sorted(counts.items()))
+            print("\nfigure: fuzz %s: %d cases: %s" % (kind, sum(counts.values()), details))
+
+
+# -- mutations ----------------------------------------------------------------------------------------------------
+def _parents(root):
+    return {child: parent for parent in root.iter() for child in parent}
+
+
+def mutate(data, root, reference_attributes):
+    """One random damage to the XML tree ``root``."""
+    parents = _parents(root)
+    elements = [element for element in root.iter() if element is not root]
+    if not elements:
+        root.text = data.draw(st.sampled_from(BAD_NUMBERS))
+        return
+    kind = data.draw(st.sampled_from(("delete", "text", "attribute", "reference", "duplicate", "mesh")))
+    element = data.draw(st.sampled_from(elements))
+    if kind == "delete":
+        parents[element].remove(element)
+    elif kind == "text":
+        leaves = [e for e in elements if len(e) == 0] or elements
+        target = data.draw(st.sampled_from(leaves))
+        target.text = data.draw(st.sampled_from(BAD_NUMBERS + BAD_VECTORS) | st.floats().map(repr)
+                                | st.text(max_size=8))
+    elif kind == "attribute":
+        with_attributes = [(e, name) for e in elements for name in e.attrib] or [(element, "name")]
+        target, name = data.draw(st.sampled_from(with_attributes))
+        target.set(name, data.draw(st.sampled_from(BAD_NUMBERS + BAD_VECTORS) | st.text(max_size=8)))
+    elif kind == "reference":
+        candidates = [(e, name) for e in elements for name in e.attrib if name in reference_attributes]
+        candidates += [(e, None) for e in elements if e.tag in REFERENCE_TAGS]
+        if candidates:
+            target, name = data.draw(st.sampled_from(candidates))
+            broken = data.draw(st.sampled_from(("nowhere", "", "model://nowhere", "base_link", "world")))
+            if name is None:
+                target.text = broken
+            else:
+                target.set(name, broken)
+    elif kind == "duplicate":
+        parents[element].append(copy.deepcopy(element))
+    else:
+        geometries = [e for e in elements if e.tag == "geometry"]
+        if geometries:
+            geometry = data.draw(st.sampled_from(geometries))
+            for child in list(geometry):
+                geometry.remove(child)
+            mesh = ET.SubElement(geometry, "mesh", filename=data.draw(st.sampled_from(MESHES)))
+            ET.SubElement(mesh, "uri").text = mesh.get("filename")
+
+
+# -- states -------------------------------------------------------------------------------------------------------
+def assert_finite_state(sim, label):
+    for name in sim.model_names():
+        pose = sim.engine.model_pose(name)
+        linear, angular = sim.engine.model_velocity(name)
+        values = tuple(pose.position) + tuple(pose.orientation) + tuple(linear) + tuple(angular)
+        assert all(math.isfinite(v) for v in values), "%s: model '%s' has a non-finite state %s" % (label, name,
+                                                                                                    values)
+    for spawned in sim.models.values():
+        robot = spawned.robot
+        for position, velocity, _ in robot.joint_state(list(robot.movable_joints)):
+            assert math.isfinite(position) and math.isfinite(velocity), "%s: '%s' joints" % (label, spawned.name)
+
+
+def step_and_check(sim, label, command=(0.5, 1.0)):
+    plugins = {name: list(spawned.plugins) for name, spawned in sim.models.items()}
+    for spawned in sim.models.values():
+        for plugin in spawned.plugins:
+            if isinstance(plugin, DiffDrive):
+                plugin.set_command(*command)
+    sim.step(STEPS)
+    assert_finite_state(sim, label)
+    for name, spawned in sim.models.items():
+        # A plugin that failed was disabled by the loop's guard: the validation let a bad value through.
+        assert spawned.plugins == plugins[name], "%s: a plugin of '%s' failed while stepping" % (label, name)
+        for plugin in spawned.plugins:
+            if isinstance(plugin, DiffDrive):
+                values = np.hstack([np.ravel(part) for part in plugin.odometry()[0]] + list(plugin.odometry()[1:]))
+                assert np.all(np.isfinite(values)), "%s: odometry %s" % (label, values)
+
+
+# -- robot descriptions -------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def simulation():
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_REGISTRY)
+    yield sim
+    sim.close()
+
+
+@pytest.fixture(scope="module")
+def fifo():
+    directory = tempfile.mkdtemp(prefix="mbot_fuzz_")
+    path = os.path.join(directory, "mesh.stl")
+    os.mkfifo(path)
+    yield path
+    os.unlink(path)
+    os.rmdir(directory)
+
+
+@settings(FUZZ, max_examples=250)
+@given(data=st.data())
+def test_malformed_robot_descriptions(data, laser_mbot_urdf, simulation, fifo):
+    root = ET.fromstring(laser_mbot_urdf)
+    for _ in range(data.draw(st.integers(1, 3))):
+        mutate(data, root, ("link", "reference", "joint", "name"))
+    if data.draw(st.integers(0, 19)) == 0:
+        # A mesh that is a FIFO: reading it would block for ever.
+        geometry = root.find("link/collision/geometry")
+        if geometry is not None:
+            for child in list(geometry):
+                geometry.remove(child)
+            ET.SubElement(geometry, "mesh", filename=fifo)
+    xml = ET.tostring(root, encoding="unicode")
+    try:
+        with watchdog():
+            model = parse_robot(xml, "model 'fuzz'")
+            simulation.spawn_robot(model, "fuzz")
+    except BridgeError as error:
+        assert "fuzz" not in simulation.model_names(), "a refused model was left behind"
+        refused("robot descriptions", error)
+        return
+    try:
+        with watchdog():
+            step_and_check(simulation, "mutated robot")
+        tally("robot descriptions", "loaded")
+    finally:
+        simulation.delete("fuzz")
+
+
+# -- worlds -------------------------------------------------------------------------------------------------------
+WORLD_BASES = [os.path.join(WORLDS, name) for name in ("playground.world", "room.world", "empty.world")] + [
+    os.path.join(TEST_WORLDS, name) for name in ("dynamics.world", "include.world", "meshes.world",
+                                                 "nested_poses.world", "relative_to.world", "friction.world")]
+
+
+@pytest.fixture(scope="module")
+def world_directory():
+    """A scratch folder beside which the test worlds' relative meshes resolve as they do from test/worlds."""
+    directory = tempfile.mkdtemp(prefix="mbot_fuzz_worlds_")
+    os.symlink(os.path.join(TEST_WORLDS, "meshes"), os.path.join(directory, "meshes"))
+    yield directory
+    for name in os.listdir(directory):
+        os.unlink(os.path.join(directory, name))
+    os.rmdir(directory)
+
+
+@settings(FUZZ, max_examples=120)
+@given(data=st.data())
+def test_malformed_worlds(data, world_directory):
+    base = data.draw(st.sampled_from(WORLD_BASES))
+    root = ET.parse(base).getroot()
+    for _ in range(data.draw(st.integers(1, 3))):
+        mutate(data, root, ("name", "relative_to", "attached_to"))
+    path = os.path.join(world_directory, "fuzz.world")
+    with open(path, "w") as world_file:
+        world_file.write(ET.tostring(root, encoding="unicode"))
+    model_path = default_model_path() + [os.path.join(TEST_WORLDS, "models")]
+    try:
+        with watchdog():
+            world = parse_world(path, model_path)
+            sim = Simulation(world, CORE_REGISTRY)
+    except BridgeError as error:
+        refused("worlds", error)
+        return
+    try:
+        with watchdog():
+            step_and_check(sim, "mutated %s" % os.path.basename(base))
+        tally("worlds", "loaded")
+    finally:
+        sim.close()
+
+
+# -- service-like requests ----------------------------------------------------------------------------------------
+# Mostly plausible values, so that requests get past the checks and the engine is exercised too.
+NUMBERS = st.one_of(st.floats(-10, 10), st.floats(-10, 10), st.floats(allow_nan=True, allow_infinity=True),
+                    st.sampled_from((0.0, -0.0, 1e5, -1e5, 1e4, -1e4, 1e-300)))
+VECTOR = st.tuples(NUMBERS, NUMBERS, NUMBERS)
+QUATERNION = st.tuples(NUMBERS, NUMBERS, NUMBERS, NUMBERS)
+# Names with line breaks are left out: the node's name check refuses them for spawns, and messages about them
+# (model 'a<newline>b' does not exist) would span lines.
+NAMES = st.sampled_from(("mbot", "ground_plane", "nowhere", "", "mbot/", "MBOT")) | st.text(
+    st.characters(blacklist_categories=("Cc", "Cs", "Zl", "Zp")), max_size=6)
+
+
+def service_pose(position, quaternion):
+    """The pose a gazebo_msgs request turns into (services.py): its quaternion normalised, zero = identity.
+    hypot, not a sum of squares: a component above 1.3e154 squares to inf, which would normalise to zeros."""
+    norm = math.hypot(*quaternion)
+    if norm == 0:
+        return Pose(position, (0.0, 0.0, 0.0, 1.0))
+    return Pose(position, tuple(v / norm for v in quaternion))
+
+
+@pytest.fixture(scope="module")
+def mbot_model(mbot_urdf):
+    return parse_robot(mbot_urdf, "model 'mbot'")
+
+
+REQUESTS = st.one_of(
+    st.tuples(st.just("set_model_state"), NAMES, VECTOR, QUATERNION, VECTOR, VECTOR),
+    st.tuples(st.just("spawn_robot"), NAMES, VECTOR, QUATERNION),
+    st.tuples(st.just("spawn_sdf"), NAMES, VECTOR, QUATERNION,
+              st.sampled_from(("<sdf version='1.6'><model name='m'><link name='l'><collision name='c'><geometry>"
+                               "<box><size>1 1 1</size></box></geometry></collision></link></model></sdf>",
+                               "<sdf><model name='m'><pose>%s</pose></model></sdf>" % BAD_VECTORS[0],
+                               "<robot name='r'/>", "", "<sdf>", "<sdf version='1.6'><world name='w'/></sdf>"))),
+    st.tuples(st.just("delete"), NAMES),
+    st.tuples(st.just("command"), NUMBERS, NUMBERS),
+    st.tuples(st.sampled_from(("reset_world", "reset_simulation"))),
+)
+
+
+def _apply(sim, request, mbot_urdf):
+    name = request[0]
+    if name == "set_model_state":
+        _, model, position, quaternion, linear, angular = request
+        sim.engine.set_model_state(model, service_pose(position, quaternion), linear, angular)
+    elif name == "spawn_robot":
+        _, model, position, quaternion = request
+        sim.spawn_robot(parse_robot(mbot_urdf, "model '%s'" % model), model, service_pose(position, quaternion))
+    elif name == "spawn_sdf":
+        _, model, position, quaternion, xml = request
+        world_xml = spawn_world_xml(xml, model, service_pose(position, quaternion))
+        with tempfile.NamedTemporaryFile("w", suffix=".world") as world_file:
+            world_file.write(world_xml)
+            world_file.flush()
+            sim.add_world(parse_world(world_file.name))
+    elif name == "delete":
+        sim.delete(request[1])
+    elif name == "command":
+        for spawned in sim.models.values():
+            for plugin in spawned.plugins:
+                if isinstance(plugin, DiffDrive):
+                    plugin.set_command(request[1], request[2])
+    else:
+        sim.reset(simulation=name == "reset_simulation")
+
+
+@settings(FUZZ, max_examples=150)
+@given(requests=st.lists(REQUESTS, min_size=1, max_size=4))
+def test_garbage_requests(requests, mbot_model, mbot_urdf):
+    """A fresh world with the mbot for each sequence, so that a failure shrinks to the requests that made it."""
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_REGISTRY)
+    try:
+        sim.spawn_robot(mbot_model, "mbot")
+        for request in requests:
+            try:
+                with watchdog():
+                    _apply(sim, request, mbot_urdf)
+                tally("service requests", "done (%s)" % request[0])
+            except BridgeError as error:
+                refused("service requests", error)
+        with watchdog():
+            sim.step(STEPS // 4)
+            assert_finite_state(sim, "after %s" % (requests,))
+            # Whatever the requests did, reset_world brings every model back to a finite spawn state.
+            sim.reset(simulation=False)
+            sim.step(10)
+            assert_finite_state(sim, "reset after %s" % (requests,))
+    finally:
+        sim.close()
+
+
+# -- what the fuzzing found, kept as plain cases ------------------------------------------------------------------
+def _laser_mbot_with(urdf, edit):
+    root = ET.fromstring(urdf)
+    edit(root)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _duplicate_joint(root):
+    root.append(copy.deepcopy(root.find("joint[@name='left_wheel_joint']")))
+
+
+def _empty_geometry(root):
+    geometry = root.find("link[@name='left_wheel_link']/collision/geometry")
+    for child in list(geometry):
+        geometry.remove(child)
+
+
+def _second_parent(root):
+    joint = copy.deepcopy(root.find("joint[@name='lidar_joint']"))
+    joint.set("name", "second_lidar_joint")
+    joint.find("parent").set("link", "left_wheel_link")
+    root.append(joint)
+
+
+@pytest.mark.parametrize("edit, expected", [
+    # PyBullet crashed the whole process (segmentation fault).
+    (_duplicate_joint, "joint 'left_wheel_joint': defined twice"),
+    # PyBullet: "Cannot load URDF file", naming nothing.
+    (lambda root: root.append(copy.deepcopy(root.find("link[@name='laser_link']"))),
+     "link 'laser_link' is defined twice"),
+    (_empty_geometry, "link 'left_wheel_link' collision <geometry> needs one shape"),
+    # Loaded silently, one of the two parents dropped.
+    (_second_parent, "child link 'laser_link' already has a parent joint, 'lidar_joint'"),
+    # Absurd shapes and inertials went into the physics (a mass of 1e300 gives a NaN pose).
+    (lambda root: root.find("link[@name='base_link']/collision/geometry/cylinder").set("radius", "-0.16"),
+     "link 'base_link' collision <cylinder radius>: -0.16 is outside the valid range > 0"),
+    (lambda root: root.find("link[@name='base_link']/inertial/inertia").set("ixx", "-1"),
+     "link 'base_link': <inertia ixx>: -1 is outside the valid range >= 0"),
+    (lambda root: root.find("link[@name='base_link']/inertial/mass").set("value", "1e300"),
+     "link 'base_link': <mass value>: 1e+300 is outside the valid range >= 0 and <= 1e+09"),
+    # 36 million rays per scan took the machine's memory.
+    (lambda root: setattr(root.find(".//sensor/ray/scan/horizontal/resolution"), "text", "1e5"),
+     "3.6e+07 ranges per scan; at most 262144 are simulated"),
+])
+def test_found_by_fuzzing(laser_mbot_urdf, simulation, edit, expected):
+    with pytest.raises(BridgeError) as error:
+        with watchdog():
+            simulation.spawn_robot(parse_robot(_laser_mbot_with(laser_mbot_urdf, edit), "model 'fuzz'"), "fuzz")
+    assert expected in str(error.value) and "\n" not in str(error.value)
+    assert "fuzz" not in simulation.model_names()
+
+
+def test_a_bad_visual_is_left_out(laser_mbot_urdf, simulation, caplog):
+    def bad_visual(root):
+        root.find("link[@name='base_link']/visual/geometry/cylinder").set("length", "nan")
+    spawned = simulation.spawn_robot(parse_robot(_laser_mbot_with(laser_mbot_urdf, bad_visual), "model 'seen'"), "seen")
+    try:
+        assert "model 'seen': link 'base_link' visual <cylinder length>: NaN is not a valid value" in caplog.text
+        assert "the visual is left out" in caplog.text
+        assert spawned.plugins
+    finally:
+        simulation.delete("seen")

@@ -1,0 +1,145 @@
+"""core/imu.py and core/p3d.py on the course's mbot with an IMU board on a fixed joint (lumped, as
+TurtleBot3's imu_link): at rest, turning at 0.5 rad/s, and against the world pose."""
+import numpy as np
+import pytest
+
+from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
+from mbot_sim_bridge.core.imu import ImuModelPlugin, ImuSensor
+from mbot_sim_bridge.core.p3d import P3D
+from mbot_sim_bridge.core.robot_model import parse_robot
+
+from sensor_fixtures import course_urdf, plugin_of, with_imu, world_simulation
+
+ACCEL_SIGMA = 0.017
+
+
+@pytest.fixture(scope="module")
+def mbot_urdf():
+    return course_urdf("mbot_gazebo")
+
+
+def spawn(tmp_path, urdf, yaw_angle=0.7):
+    sim = world_simulation(tmp_path)
+    pose = pose_from_xyz_rpy((0.5, -0.2, 0.0), (0, 0, yaw_angle))
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot", pose)
+    return sim, spawned
+
+
+def test_imu_sensor_at_rest_reads_gravity_up_and_the_true_yaw(mbot_urdf, tmp_path):
+    sim, spawned = spawn(tmp_path, with_imu(mbot_urdf, accel_noise=True))
+    try:
+        sensor = plugin_of(spawned, ImuSensor)
+        assert sensor.timer.period == pytest.approx(0.01)  # min(<update_rate> 200, updateRateHZ 100)
+        sim.step(1500)
+        readings = []
+        for _ in range(50):
+            sim.step(10)
+            readings.append(sensor.latest)
+        accel_z = np.array([reading.linear_acceleration[2] for reading in readings])
+        gravity = abs(sim.engine.physics.gravity[2])
+        truth = yaw(spawned.robot.root_pose().orientation)
+        yaw_error = abs(yaw(readings[-1].orientation) - truth)
+        print(f"figure: imu sensor at rest: linear_acceleration.z mean {accel_z.mean():.4f} m/s^2, std "
+              f"{accel_z.std():.4f} (noise sigma {ACCEL_SIGMA}; world gravity {gravity}); yaw error "
+              f"{yaw_error:.2e} rad")
+        assert abs(accel_z.mean() - 9.81) < 3 * ACCEL_SIGMA
+        assert np.all(np.abs(accel_z - gravity) < 5 * ACCEL_SIGMA)
+        assert accel_z.std() == pytest.approx(ACCEL_SIGMA, rel=0.5)
+        assert yaw_error < 0.01
+        assert readings[-1].covariance == 0.0
+    finally:
+        sim.close()
+
+
+def test_turning_at_half_a_radian_per_second(mbot_urdf, tmp_path):
+    sim, spawned = spawn(tmp_path, with_imu(mbot_urdf))
+    try:
+        sensor, model_imu = plugin_of(spawned, ImuSensor), plugin_of(spawned, ImuModelPlugin)
+        plugin_of(spawned, DiffDrive).set_command(0.0, 0.5)
+        sim.step(3000)
+        rates = []
+        for _ in range(20):
+            sim.step(10)
+            rates.append((sensor.latest.angular_velocity[2], model_imu.latest.angular_velocity[2]))
+        sensor_rate, model_rate = np.mean(rates, axis=0)
+        true_rate = spawned.robot.link_world_velocity("base_link")[1][2]
+        print(f"figure: turning at 0.5 rad/s: imu sensor angular_velocity.z {sensor_rate:.4f}, libgazebo_ros_imu "
+              f"{model_rate:.4f}, true {true_rate:.4f} rad/s")
+        assert sensor_rate == pytest.approx(0.5, rel=0.02)
+        assert model_rate == pytest.approx(0.5, rel=0.02)
+        assert sensor_rate == pytest.approx(true_rate, rel=0.005)
+    finally:
+        sim.close()
+
+
+def test_model_imu_is_gazebo_s_lumped_body_without_gravity(mbot_urdf, tmp_path):
+    sim, spawned = spawn(tmp_path, with_imu(mbot_urdf))
+    try:
+        imu = plugin_of(spawned, ImuModelPlugin)
+        # sdformat renames a lumped bodyName/frameName to the surviving link, as TurtleBot3's /imu shows.
+        assert imu.link == "base_footprint" and imu.frame_name == "base_footprint"
+        sim.step(1500)
+        reading = imu.latest
+        yaw_error = abs(yaw(reading.orientation) - yaw(spawned.robot.root_pose().orientation))
+        print(f"figure: libgazebo_ros_imu at rest: linear_acceleration {np.round(reading.linear_acceleration, 4)} "
+              f"(Gazebo leaves gravity out of this plugin), yaw error {yaw_error:.2e} rad")
+        assert np.abs(reading.linear_acceleration).max() < 0.05
+        assert yaw_error < 0.01
+    finally:
+        sim.close()
+
+
+def test_p3d_equals_the_world_pose(mbot_urdf, tmp_path):
+    sim, spawned = spawn(tmp_path, with_imu(mbot_urdf))
+    try:
+        p3d = plugin_of(spawned, P3D)
+        plugin_of(spawned, DiffDrive).set_command(0.3, 0.4)
+        sim.step(2000)
+        truth = p3d.read(sim.sim_time)
+        pose = spawned.robot.link_world_pose("base_link")
+        velocity = spawned.robot.link_world_velocity("base_link")
+        position_error = max(abs(a - b) for a, b in zip(truth.pose.position, pose.position))
+        q, r = np.asarray(truth.pose.orientation), np.asarray(pose.orientation)
+        angle_error = min(np.abs(q - r).max(), np.abs(q + r).max())  # quaternion components
+        print(f"figure: p3d vs world pose: position error {position_error:.2e} m, quaternion {angle_error:.2e}; "
+              f"frame '{p3d.frame_name}', child '{p3d.child_frame}'")
+        assert position_error < 1e-9 and angle_error < 1e-9
+        assert truth.linear == pytest.approx(velocity[0]) and truth.angular == pytest.approx(velocity[1])
+        assert (p3d.frame_name, p3d.child_frame) == ("world", "base_footprint")
+    finally:
+        sim.close()
+
+
+def test_bad_imu_and_p3d_tags_are_refused_with_the_tag(mbot_urdf, tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        bad = with_imu(mbot_urdf).replace("<bodyName>imu_link</bodyName>", "<bodyName>nowhere</bodyName>")
+        with pytest.raises(ConfigError, match="bodyName: nowhere does not exist"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        bad = with_imu(mbot_urdf).replace("<frameName>imu_link</frameName>\n                <updateRateHZ>",
+                                          "<updateRateHZ>")
+        with pytest.raises(ConfigError, match="frameName"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        bad = with_imu(mbot_urdf).replace("<updateRate>50</updateRate>", "<updateRate>-1</updateRate>")
+        with pytest.raises(ConfigError, match="updateRate"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        assert "mbot" not in sim.model_names()
+    finally:
+        sim.close()
+
+
+def test_an_unknown_sensor_warns_once_and_the_rest_works(mbot_urdf, tmp_path, caplog):
+    sonar = """<gazebo reference="base_link"><sensor type="sonar" name="front_sonar"><update_rate>10</update_rate>
+        <plugin name="sonar" filename="libgazebo_ros_range.so"><topicName>sonar</topicName></plugin></sensor></gazebo>
+        </robot>"""
+    sim = world_simulation(tmp_path)
+    try:
+        spawned = sim.spawn_robot(parse_robot(with_imu(mbot_urdf).replace("</robot>", sonar), "model 'mbot'"), "mbot")
+        sim.step(100)
+        warnings = [record.getMessage() for record in caplog.records if "libgazebo_ros_range.so" in record.getMessage()]
+        assert len(warnings) == 1 and "not emulated" in warnings[0]
+        assert plugin_of(spawned, ImuSensor).latest is not None and plugin_of(spawned, P3D).latest is not None
+    finally:
+        sim.close()

@@ -1,0 +1,390 @@
+"""core/ros_control.py, core/controllers.py, core/gazebo_ros_control.py: transmissions, limits, the PID, the diff
+drive's odometry and speed limiter, the controller manager's state machine and texts, and the mbot and a
+two-joint arm driven through the controllers in the simulation, with no ROS master."""
+import logging
+import math
+import os
+import threading
+
+import pytest
+import yaml
+
+from mbot_sim_bridge.core.controllers import DiffDriveOdometry, SpeedLimiter
+from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.gazebo_ros_control import RosControl
+from mbot_sim_bridge.core.geometry import yaw
+from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.ros_control import (JointLimits, Pid, apply_limit_params, parse_transmissions,
+                                              shortest_angular_distance_with_limits)
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.core.xml_values import parse_xml
+
+from conftest import WORKSPACE_SRC, expand_xacro
+
+WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
+MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
+ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
+
+
+def load_yaml(path):
+    with open(path) as stream:
+        return yaml.safe_load(stream)
+
+
+def simulate(urdf, params, name="robot"):
+    """A Simulation with the robot spawned; its gazebo_ros_control reads ``params`` as the parameter server."""
+    class CoreRosControl(RosControl):
+        def controller_params(self, controller):
+            return params.get(controller)
+
+        def ros_param(self, path):
+            return params.get(path)
+
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")),
+                     {"libgazebo_ros_control.so": CoreRosControl,
+                      "libgazebo_ros_joint_state_publisher.so": JointStatePublisher})
+    spawned = sim.spawn_robot(parse_robot(urdf, "model '%s'" % name), name)
+    plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, RosControl))
+    return sim, spawned, plugin
+
+
+def switch(sim, manager, start=(), stop=(), strictness=2):
+    """A switch as the service does it: requested from another thread, performed by the next control update."""
+    result = []
+    thread = threading.Thread(target=lambda: result.append(manager.switch(list(start), list(stop), strictness)))
+    thread.start()
+    while thread.is_alive():
+        sim.step(1)
+    return result[0]
+
+
+@pytest.fixture(scope="module")
+def mbot_ros_control_urdf():
+    return expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro")
+
+
+@pytest.fixture
+def mbot(mbot_ros_control_urdf):
+    sim, spawned, plugin = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot")
+    manager = plugin.manager
+    assert manager.load("joint_state_controller", plugin.urdf)
+    assert manager.load("mobile_base_controller", plugin.urdf)
+    assert switch(sim, manager, ["joint_state_controller", "mobile_base_controller"])
+    yield sim, spawned, plugin, manager.find("mobile_base_controller").controller
+    sim.close()
+
+
+# -- transmissions and limits ----------------------------------------------------------------------------------
+TRANSMISSIONS = """<robot name="t">
+  <transmission name="new_style"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="a"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+    <actuator name="a_motor"><mechanicalReduction>50</mechanicalReduction></actuator></transmission>
+  <transmission name="old_style"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="b"/>
+    <actuator name="b_motor"><hardwareInterface>VelocityJointInterface</hardwareInterface></actuator></transmission>
+  <transmission name="no_actuator"><type>transmission_interface/SimpleTransmission</type><joint name="c"/>
+  </transmission>
+</robot>"""
+
+
+def test_transmissions_are_read_at_joint_and_old_actuator_level(caplog):
+    document = parse_xml(TRANSMISSIONS.encode(), "test")
+    transmissions = parse_transmissions(document.root, document.where)
+    assert [t.name for t in transmissions] == ["new_style", "old_style"]
+    assert transmissions[0].joints == [("a", ["hardware_interface/EffortJointInterface"])]
+    assert transmissions[0].actuators == [("a_motor", [], 50.0)]
+    assert transmissions[1].joints == [("b", [])] and transmissions[1].actuators[0][1] == ["VelocityJointInterface"]
+    assert "transmission 'no_actuator' has no <actuator>" in caplog.text
+
+
+def test_a_bad_mechanical_reduction_is_refused():
+    document = parse_xml(TRANSMISSIONS.replace(">50<", ">fifty<").encode(), "test")
+    with pytest.raises(ConfigError, match="<mechanicalReduction> 'fifty' is not a number"):
+        parse_transmissions(document.root, document.where)
+
+
+def test_the_mbot_wheels_are_velocity_joints_without_limits(mbot):
+    _, _, plugin, _ = mbot
+    assert {name: joint.interface for name, joint in plugin.hw.joints.items()} == {
+        "left_wheel_joint": "VelocityJointInterface", "right_wheel_joint": "VelocityJointInterface"}
+    assert all(joint.limits is None for joint in plugin.hw.joints.values())
+    assert plugin.driven_joints == ("left_wheel_joint", "right_wheel_joint")
+    assert plugin.control_period == pytest.approx(0.001)
+
+
+def test_joint_limit_parameters_override_the_urdf():
+    limits = apply_limit_params(JointLimits(True, -1.0, 1.0, True, 2.0), {
+        "has_velocity_limits": True, "max_velocity": 0.5, "has_effort_limits": True, "max_effort": 7}, "j")
+    assert (limits.min_position, limits.max_velocity, limits.has_effort_limits, limits.max_effort) == (-1, 0.5, True, 7)
+
+
+def test_shortest_angular_distance_with_limits_takes_the_way_within_them():
+    assert shortest_angular_distance_with_limits(0.1, -0.1, -1.0, 1.0) == pytest.approx(-0.2)
+    # From 3 to -3 the short way crosses pi, outside [-3.1, 3.1]: the long way round.
+    assert shortest_angular_distance_with_limits(3.0, -3.0, -3.1, 3.1) == pytest.approx(-6.0)
+
+
+# -- maths -------------------------------------------------------------------------------------------------------
+def test_pid_terms_clamp_and_antiwindup():
+    pid = Pid(p=2.0, i=1.0, d=0.5, i_max=0.3, i_min=-0.3)
+    # First call: upstream's reset leaves the last error at 0 and "valid", so d sees the whole step.
+    assert pid.compute(1.0, 0.1) == pytest.approx(2.0 + 0.1 + 0.5 * 10.0)
+    assert pid.compute(1.0, 0.1) == pytest.approx(2.0 + 0.2)
+    for _ in range(100):
+        pid.compute(1.0, 0.1)
+    assert pid.compute(1.0, 0.1) == pytest.approx(2.0 + 0.3)  # the i term is clamped, the integral is not
+    assert pid.i_error > 10
+    windup_free = Pid(p=0.0, i=1.0, i_max=0.3, i_min=-0.3, antiwindup=True)
+    for _ in range(100):
+        windup_free.compute(1.0, 0.1)
+    assert windup_free.i_error == pytest.approx(0.3)
+    assert Pid.from_params({"i": 1.0}, "/ns/pid", quiet=True) is None
+    gains = Pid.from_params({"p": 1, "i_clamp": -2.0, "i_clamp_max": 5.0}, "/ns/pid")
+    assert (gains.i_min, gains.i_max) == (-2.0, 5.0)
+
+
+def test_speed_limiter_velocity_acceleration_and_jerk():
+    limiter = SpeedLimiter.from_params({"linear": {"x": {"has_velocity_limits": True, "max_velocity": 1.0,
+                                                         "has_acceleration_limits": True, "max_acceleration": 2,
+                                                         "min_acceleration": -4.0}}}, "linear/x", "test")
+    assert limiter.min_velocity == -1.0
+    assert limiter.limit(5.0, 0.0, 0.0, 0.1) == pytest.approx(0.2)
+    assert limiter.limit(-5.0, 0.0, 0.0, 0.1) == pytest.approx(-0.4)
+    assert limiter.limit(5.0, 0.95, 0.9, 0.1) == pytest.approx(1.0)
+    jerk = SpeedLimiter(has_jerk_limits=True, min_jerk=-1.0, max_jerk=1.0)
+    # dv - dv0 limited to ±jerk·2·dt²: from a steady 0.5 the next step may change by at most 0.02.
+    assert jerk.limit(1.0, 0.5, 0.5, 0.1) == pytest.approx(0.52)
+
+
+def test_odometry_integrates_wheel_positions_exactly_on_an_arc():
+    odometry = DiffDriveOdometry(window=10)
+    odometry.set_wheel_params(0.4, 0.1, 0.1)
+    odometry.init(0.0)
+    # Both wheels on a circle of radius R about the centre: left R - 0.2, right R + 0.2, for 1 rad.
+    radius, turn, steps = 1.0, 1.0, 100
+    for k in range(1, steps + 1):
+        arc = turn * k / steps
+        odometry.update(arc * (radius - 0.2) / 0.1, arc * (radius + 0.2) / 0.1, k * 0.01)
+    assert odometry.heading == pytest.approx(turn)
+    assert (odometry.x, odometry.y) == pytest.approx((math.sin(turn), 1 - math.cos(turn)))
+    assert odometry.linear == pytest.approx(radius * turn / 1.0)
+    assert odometry.angular == pytest.approx(turn / 1.0)
+
+
+# -- the controller manager --------------------------------------------------------------------------------------
+def test_list_switch_and_unload_behave_as_upstream(mbot, caplog):
+    sim, _, plugin, _ = mbot
+    manager = plugin.manager
+    assert [(c.name, c.state, c.claimed) for c in manager.list()] == [
+        ("joint_state_controller", "running", [("hardware_interface::JointStateInterface", [])]),
+        ("mobile_base_controller", "running",
+         [("hardware_interface::VelocityJointInterface", ["right_wheel_joint", "left_wheel_joint"])])]
+    assert not manager.load("mobile_base_controller", plugin.urdf)
+    assert "A controller named 'mobile_base_controller' was already loaded" in caplog.text
+    assert not manager.unload("mobile_base_controller")
+    assert "because it is still running" in caplog.text
+    assert not switch(sim, manager, start=["mobile_base_controller"])
+    assert "Controller 'mobile_base_controller' is already running" in caplog.text
+    assert not switch(sim, manager, stop=["nothing"])
+    assert "Could not stop controller with name 'nothing' because no controller with this name exists" in caplog.text
+    assert switch(sim, manager, start=["mobile_base_controller"], stop=["nothing"], strictness=1)
+    assert switch(sim, manager, stop=["mobile_base_controller"])
+    assert manager.find("mobile_base_controller").state == "stopped"
+    assert all(joint.command == 0.0 for joint in plugin.hw.joints.values())  # stopping brakes
+    assert not switch(sim, manager, stop=["mobile_base_controller"])
+    assert "Could not stop controller 'mobile_base_controller' since it is not running" in caplog.text
+    assert manager.unload("mobile_base_controller")
+    assert [c.name for c in manager.list()] == ["joint_state_controller"]
+    assert not manager.unload("mobile_base_controller")
+    assert "because no controller with this name exists" in caplog.text
+
+
+def test_resource_conflicts_refuse_the_switch(mbot, caplog):
+    sim, _, plugin, _ = mbot
+    manager = plugin.manager
+    manager.get_params = lambda name: {"type": "velocity_controllers/JointVelocityController",
+                                       "joint": "left_wheel_joint"}
+    assert manager.load("wheel_velocity", plugin.urdf)
+    assert not switch(sim, manager, start=["wheel_velocity"])
+    assert "Resource conflict on [left_wheel_joint].  Controllers = [mobile_base_controller, wheel_velocity, ]" \
+        in caplog.text
+    assert "Could not switch controllers, due to resource conflict" in caplog.text
+    assert switch(sim, manager, start=["wheel_velocity"], stop=["mobile_base_controller"])
+    assert manager.find("wheel_velocity").state == "running"
+
+
+def test_unknown_type_missing_type_and_unknown_joint_fail_with_upstream_texts(mbot, caplog):
+    sim, _, plugin, controller = mbot
+    manager = plugin.manager
+    configs = {
+        "typo": {"type": "diff_drive_controller/DiffDriveControler"},
+        "untyped": {"left_wheel": "x"},
+        "ghost_wheels": {"type": "diff_drive_controller/DiffDriveController", "left_wheel": "ghost_joint",
+                         "right_wheel": "left_wheel_joint"},
+        "ghost_forward": {"type": "position_controllers/JointGroupPositionController", "joints": ["ghost_joint"]},
+    }
+    manager.get_params = configs.get
+    for name in configs:
+        assert not manager.load(name, plugin.urdf)
+    assert ("Could not load controller 'typo' because controller type 'diff_drive_controller/DiffDriveControler' "
+            "does not exist.") in caplog.text
+    assert "Use 'rosservice call controller_manager/list_controller_types' to get the available types" in caplog.text
+    assert ("Could not load controller 'untyped' because the type was not specified. Did you load the controller "
+            "configuration on the parameter server (namespace: '/untyped')?") in caplog.text
+    assert "ghost_joint couldn't be retrieved from model description" in caplog.text
+    assert "Initializing controller 'ghost_wheels' failed" in caplog.text
+    assert ("Exception thrown: Could not find resource 'ghost_joint' in "
+            "'hardware_interface::PositionJointInterface'.") in caplog.text
+    # The rest keeps running.
+    assert [c.state for c in manager.list()] == ["running", "running"]
+    controller.set_command(0.2, 0.0, sim.sim_time)
+    sim.step(500)
+    assert controller.odometry.linear == pytest.approx(0.2, rel=0.05)
+
+
+# -- the mbot through diff_drive_controller ----------------------------------------------------------------------
+def measured_motion(sim, spawned, controller, linear, angular, settle=1.5, window=1.0):
+    """Command (re-sent well within cmd_vel_timeout), settle, then ground truth over a window."""
+    def run(seconds):
+        for _ in range(int(round(seconds / 0.05))):
+            controller.set_command(linear, angular, sim.sim_time)
+            sim.step(50)
+    run(settle)
+    start, pose0 = sim.sim_time, spawned.robot.root_pose()
+    run(window)
+    pose1, dt = spawned.robot.root_pose(), sim.sim_time - start
+    heading = yaw(pose0.orientation)
+    dx, dy = (pose1.position[i] - pose0.position[i] for i in range(2))
+    return ((dx * math.cos(heading) + dy * math.sin(heading)) / dt,
+            math.remainder(yaw(pose1.orientation) - heading, 2 * math.pi) / dt)
+
+
+@pytest.mark.parametrize("linear", [0.2, -0.2])
+def test_the_mbot_tracks_linear_speed(mbot, linear):
+    sim, spawned, _, controller = mbot
+    speed, _ = measured_motion(sim, spawned, controller, linear, 0.0)
+    assert speed == pytest.approx(linear, rel=0.05)
+
+
+@pytest.mark.parametrize("angular", [0.5, -1.0])
+def test_the_mbot_tracks_yaw_rate_and_turns_left_on_positive(mbot, angular):
+    sim, spawned, _, controller = mbot
+    _, yaw_rate = measured_motion(sim, spawned, controller, 0.0, angular)
+    assert yaw_rate == pytest.approx(angular, rel=0.05)
+
+
+def test_cmd_vel_timeout_stops_the_mbot(mbot):
+    sim, spawned, _, controller = mbot
+    measured_motion(sim, spawned, controller, 0.3, 0.0)
+    sim.step(int(controller.cmd_vel_timeout * 1000) + 500)  # no command for timeout + 0.5 s
+    linear, _ = spawned.robot.root_velocity()
+    assert math.hypot(linear[0], linear[1]) < 0.005
+
+
+def test_wheel_odometry_over_3_m_stays_within_2_percent(mbot):
+    sim, spawned, _, controller = mbot
+    start = spawned.robot.root_pose().position
+    for _ in range(220):  # 11 s at 0.3 m/s, with the acceleration ramp
+        controller.set_command(0.3, 0.0, sim.sim_time)
+        sim.step(50)
+    end = spawned.robot.root_pose().position
+    truth = math.hypot(end[0] - start[0], end[1] - start[1])
+    odometry = math.hypot(controller.odometry.x, controller.odometry.y)
+    assert truth > 3.0
+    assert odometry == pytest.approx(truth, rel=0.02)
+
+
+# -- the two-joint arm -------------------------------------------------------------------------------------------
+def arm(interface):
+    urdf = expand_xacro_arm(interface)
+    return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", "arm_%s.yaml" % interface.lower())), "arm")
+
+
+def expand_xacro_arm(interface):
+    import xacro
+    return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
+                              mappings={"interface": interface}).toxml()
+
+
+SETPOINTS = ((0.5, -0.8), (-1.0, 1.2), (1.5, 0.3))
+
+
+@pytest.mark.parametrize("interface, controllers", [
+    ("Effort", ("shoulder_position_controller", "elbow_position_controller")),
+    ("Position", ("arm_controller",))])
+def test_the_arm_reaches_setpoints_within_a_degree(interface, controllers):
+    sim, spawned, plugin = arm(interface)
+    try:
+        manager = plugin.manager
+        for name in controllers:
+            assert manager.load(name, plugin.urdf)
+        assert switch(sim, manager, controllers)
+        for setpoint in SETPOINTS:
+            if interface == "Effort":
+                for name, value in zip(controllers, setpoint):
+                    manager.find(name).controller.set_command(value)
+            else:
+                assert manager.find("arm_controller").controller.set_commands(list(setpoint)) is None
+            sim.step(2000)
+            reached = [state[0] for state in spawned.robot.joint_state(["shoulder", "elbow"])]
+            errors = [math.degrees(abs(a - b)) for a, b in zip(reached, setpoint)]
+            assert max(errors) < 1.0, "setpoint %s: errors %s degrees" % (setpoint, errors)
+    finally:
+        sim.close()
+
+
+def test_effort_limits_saturate_the_pid_output(caplog):
+    caplog.set_level(logging.INFO)
+    sim, _, plugin = arm("Effort")
+    try:
+        manager = plugin.manager
+        assert manager.load("shoulder_position_controller", plugin.urdf)
+        assert switch(sim, manager, ["shoulder_position_controller"])
+        manager.find("shoulder_position_controller").controller.set_command(1.9)
+        sim.step(2)
+        assert plugin.hw.joints["shoulder"].command == pytest.approx(40.0)  # the URDF's effort limit
+        assert "mechanicalReduction" not in caplog.text  # a reduction of 1 needs no remark
+    finally:
+        sim.close()
+
+
+def test_e_stop_stops_the_wheels_and_restarts_the_controllers_on_release(mbot):
+    sim, spawned, plugin, controller = mbot
+    measured_motion(sim, spawned, controller, 0.3, 0.0, settle=1.0, window=0.1)
+    plugin.e_stop = True
+    for _ in range(20):
+        controller.set_command(0.3, 0.0, sim.sim_time)
+        sim.step(50)
+    linear, _ = spawned.robot.root_velocity()
+    assert math.hypot(linear[0], linear[1]) < 0.005
+    plugin.e_stop = False
+    speed, _ = measured_motion(sim, spawned, controller, 0.3, 0.0, settle=1.0, window=0.5)
+    assert speed == pytest.approx(0.3, rel=0.05)
+
+
+@pytest.mark.parametrize("legacy", [False, True])
+def test_pid_gains_turn_position_joints_into_pid_driven_effort_joints(legacy):
+    urdf = expand_xacro_arm("Position")
+    if legacy:
+        plugin_element = '<plugin filename="libgazebo_ros_control.so" name="gazebo_ros_control"/>'
+        assert plugin_element in urdf
+        urdf = urdf.replace(plugin_element, plugin_element.replace("/>", "><legacyModeNS>true</legacyModeNS></plugin>"))
+    gains = {"shoulder": {"p": 1000.0, "i": 500.0, "d": 20.0, "i_clamp": 5.0, "antiwindup": True},
+             "elbow": {"p": 500.0, "i": 250.0, "d": 5.0, "i_clamp": 2.0, "antiwindup": True}}
+    params = dict(load_yaml(os.path.join(ROBOTS, "config", "arm_position.yaml")))
+    # Noetic reads the gains under the robot namespace (here the model name); legacyModeNS at the root.
+    params["/gazebo_ros_control/pid_gains" if legacy else "/arm/gazebo_ros_control/pid_gains"] = gains
+    sim, spawned, plugin = simulate(urdf, params, "arm")
+    try:
+        assert all(joint.pid is not None for joint in plugin.hw.joints.values())
+        manager = plugin.manager
+        assert manager.load("arm_controller", plugin.urdf)
+        assert switch(sim, manager, ["arm_controller"])
+        manager.find("arm_controller").controller.set_commands([0.7, -0.4])
+        sim.step(2000)
+        reached = [state[0] for state in spawned.robot.joint_state(["shoulder", "elbow"])]
+        assert max(math.degrees(abs(a - b)) for a, b in zip(reached, (0.7, -0.4))) < 1.0
+    finally:
+        sim.close()

@@ -1,0 +1,40 @@
+"""./mbot sim ends with the simulator's exit status when the simulator stops (server_required semantics)."""
+import os
+import signal
+import subprocess
+
+from mbot_gazebo.processes import free_port, stop_process_group
+
+from ros_processes import TESTS, run, wait_until
+
+MBOT = os.path.join(os.path.dirname(TESTS), "mbot")
+
+
+def _environment(tmp_path):
+    # A master of its own on a free port: ./mbot sim starts one when none answers.
+    return dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(), ROS_LOG_DIR=str(tmp_path))
+
+
+def test_sim_with_a_missing_world_returns_the_simulators_status(tmp_path):
+    result = run([MBOT, "sim", "empty", "world_name:=/nonexistent/missing.world"], _environment(tmp_path),
+                 timeout=120)
+    output = result.stdout + result.stderr
+    assert result.returncode == 1, output
+    assert any("[FATAL]" in line and "/nonexistent/missing.world" in line for line in output.splitlines()), output
+    assert "mbot sim: the simulator stopped (exit status 1)" in output
+
+
+def test_sim_runs_until_interrupted(tmp_path):
+    environment = _environment(tmp_path)
+    log_path = tmp_path / "sim.log"
+    with open(log_path, "w") as log:
+        simulation = subprocess.Popen([MBOT, "sim", "empty"], env=environment, stdout=log, stderr=subprocess.STDOUT,
+                                      start_new_session=True)
+    try:
+        wait_until(lambda: run(["rostopic", "echo", "-n", "1", "/odom"], environment, timeout=60).returncode == 0,
+                   120, "/odom from ./mbot sim")
+        assert simulation.poll() is None, log_path.read_text()
+        os.killpg(simulation.pid, signal.SIGINT)
+        assert simulation.wait(timeout=60) == 0, log_path.read_text()
+    finally:
+        stop_process_group(simulation)

@@ -1,0 +1,324 @@
+"""Nothing a user sends kills the simulator or wedges a robot: one test per defect of the robustness issue,
+each through the real ROS path (spawn_model, rosservice) against a running bridge with a good mbot in it.
+
+After every bad input the bridge must still serve the good mbot: /clock goes on, its /odom arrives finite,
+and it still takes requests.
+"""
+import math
+import os
+import subprocess
+import time
+from xml.etree import ElementTree
+
+import pytest
+import yaml
+
+from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from ros_processes import run, wait_until
+
+# A first spawn waits for the bridge's services; later calls are answered at once.
+CALL_TIMEOUT = 60
+# Far below what any refusal takes; before the fixes a blocked bridge ran into it.
+REFUSAL_TIMEOUT = 45
+
+
+def one_line(output, *expected):
+    assert "Traceback" not in output, output
+    lines = [line for line in output.splitlines() if all(text in line for text in expected)]
+    assert lines, "no line containing %s in:\n%s" % (expected, output)
+    return lines[0]
+
+
+@pytest.fixture(scope="module")
+def mbot_urdf():
+    """The shipped mbot (xacro output), the base the bad descriptions are made from."""
+    xacro = subprocess.run(["rosrun", "xacro", "xacro", "--inorder",
+                            os.path.join(_package("mbot_description"), "urdf", "gazebo", "mbot_gazebo.xacro")],
+                           capture_output=True, text=True, check=True)
+    return xacro.stdout
+
+
+def _package(name):
+    return subprocess.run(["rospack", "find", name], capture_output=True, text=True, check=True).stdout.strip()
+
+
+def with_drive_tags(urdf, **tags):
+    """The mbot with some of its diff-drive <plugin> tags set (added when absent)."""
+    root = ElementTree.fromstring(urdf)
+    plugin = next(p for p in root.iter("plugin") if p.get("filename") == "libgazebo_ros_diff_drive.so")
+    for tag, value in tags.items():
+        element = plugin.find(tag)
+        if element is None:
+            element = ElementTree.SubElement(plugin, tag)
+        element.text = value
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def without_namespace(urdf):
+    """The mbot without its plugins' robotNamespace "/", so that spawn_model's -robot_namespace applies."""
+    root = ElementTree.fromstring(urdf)
+    for plugin in root.iter("plugin"):
+        for element in plugin.findall("robotNamespace"):
+            plugin.remove(element)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def spawn(ros_env, tmp_path, name, xml, *arguments, kind="-urdf", timeout=REFUSAL_TIMEOUT):
+    path = tmp_path / ("%s.xml" % name)
+    path.write_text(xml)
+    return run(["rosrun", "mbot_sim_bridge", "spawn_model", kind, "-model", name, "-file", str(path), *arguments],
+               ros_env, timeout=timeout)
+
+
+def call(ros_env, service, request="{}", timeout=CALL_TIMEOUT):
+    result = run(["rosservice", "call", "/gazebo/" + service, request], ros_env, timeout=timeout)
+    assert result.returncode == 0, "rosservice call %s failed:\n%s%s" % (service, result.stdout, result.stderr)
+    return yaml.safe_load(result.stdout)
+
+
+def echo(ros_env, topic, timeout=CALL_TIMEOUT):
+    result = run(["rostopic", "echo", "-n", "1", "--noarr", topic], ros_env, timeout=timeout)
+    assert result.returncode == 0, "no message on %s:\n%s" % (topic, result.stderr)
+    return yaml.safe_load(result.stdout.split("\n---")[0])
+
+
+def model_pose(ros_env, name):
+    state = call(ros_env, "get_model_state", "{model_name: %s}" % name)
+    assert state["success"], state
+    position = state["pose"]["position"]
+    return tuple(float(position[axis]) for axis in "xyz")
+
+
+def model_names(ros_env):
+    return call(ros_env, "get_world_properties")["model_names"]
+
+
+@pytest.fixture(scope="module")
+def shared(tmp_path_factory, mbot_urdf):
+    """One bridge, with the good mbot 'good' (topics under /good), for all the tests that send it bad input:
+    each leaves it as it found it or fails, and starting one per test would cost minutes."""
+    directory = tmp_path_factory.mktemp("shared_bridge")
+    with PrivateMaster() as master:
+        environment = dict(master.environment, ROS_LOG_DIR=str(directory), PYTHONUNBUFFERED="1")
+        log_path = directory / "roslaunch.log"
+        with open(log_path, "w") as log:
+            process = subprocess.Popen(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false"],
+                                       env=environment, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        process.log_path = log_path
+        try:
+            result = spawn(environment, directory, "good", without_namespace(mbot_urdf), "-robot_namespace", "/good",
+                           timeout=CALL_TIMEOUT)
+            assert result.returncode == 0, result.stderr + open(log_path).read()
+            yield environment, process
+        finally:
+            stop_process_group(process)
+
+
+@pytest.fixture
+def env(shared):
+    return shared[0]
+
+
+@pytest.fixture
+def bridge(shared):
+    return shared[1]
+
+
+def assert_still_serving(ros_env, bridge, drive=False):
+    """The bridge runs, its clock advances, and the good mbot still publishes finite odometry (and, with
+    ``drive``, still drives: a few seconds more, spent where a request could have wedged the robot)."""
+    assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
+    first = echo(ros_env, "/clock")["clock"]
+    odometry = echo(ros_env, "/good/odom")
+    position = odometry["pose"]["pose"]["position"]
+    assert all(math.isfinite(float(position[axis])) for axis in "xyz"), odometry
+    if drive:
+        before = model_pose(ros_env, "good")
+        # A reset stops the drive (as Gazebo's Reset does): command it again each time.
+        run(["rostopic", "pub", "-1", "/good/cmd_vel", "geometry_msgs/Twist",
+             "{linear: {x: 0.2}, angular: {z: 0.5}}"], ros_env)
+        wait_until(lambda: math.dist(model_pose(ros_env, "good"), before) > 1e-3, 30, "the good mbot to move")
+    later = echo(ros_env, "/clock")["clock"]
+    assert (later["secs"], later["nsecs"]) > (first["secs"], first["nsecs"])
+    assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
+
+
+def assert_refused(result, name, *expected):
+    assert result.returncode == 1, "spawn of %s was not refused:\n%s%s" % (name, result.stdout, result.stderr)
+    return one_line(result.stderr, "spawn_model: spawning '%s' failed:" % name, *expected)
+
+
+# -- 1, 2, 4: diff-drive tags that divide by zero or fly the robot off are refused at the door --------------------
+@pytest.mark.parametrize("tags, expected", [
+    ({"wheelDiameter": "0"}, ("<wheelDiameter>", "'0'", ">= 0.001")),                          # defect 1
+    ({"wheelSeparation": "0", "odometrySource": "encoder"}, ("<wheelSeparation>", "'0'", ">= 0.001")),  # 2
+    ({"wheelDiameter": "-0.064"}, ("<wheelDiameter>", "'-0.064'", ">= 0.001")),                # defect 4
+    ({"wheelTorque": "-30"}, ("<wheelTorque>", "'-30'", ">= 0")),
+    ({"wheelAcceleration": "-1.8"}, ("<wheelAcceleration>", "'-1.8'", ">= 0")),
+    ({"wheelDiameter": "1e-300"}, ("<wheelDiameter>", "'1e-300'", ">= 0.001")),
+])
+def test_bad_wheel_tags_refuse_the_spawn(env, bridge, tmp_path, mbot_urdf, tags, expected):
+    result = spawn(env, tmp_path, "bad", with_drive_tags(mbot_urdf, **tags))
+    line = assert_refused(result, "bad", "model 'bad'", "GazeboRosDiffDrive", *expected)
+    assert "\n" not in line
+    assert "bad" not in model_names(env), "the refused model was left behind"
+    assert_still_serving(env, bridge)
+
+
+# -- 3: set_model_state with NaN is refused; no state a service leaves is beyond reset ---------------------------
+def test_set_model_state_refuses_nan_and_reset_repairs(env, bridge):
+    spawn_z = model_pose(env, "good")[2]
+    for field in ("pose: {position: {x: .nan}}", "pose: {orientation: {w: .inf}}", "twist: {linear: {z: -.inf}}",
+                  "pose: {position: {y: 1.0e+300}}"):
+        response = call(env, "set_model_state", "{model_state: {model_name: good, %s}}" % field)
+        assert response["success"] is False, (field, response)
+        assert "nothing was changed" in response["status_message"], response
+        assert "\n" not in response["status_message"]
+    x, y, z = model_pose(env, "good")
+    assert all(math.isfinite(v) for v in (x, y, z)) and abs(z - spawn_z) < 0.05
+    assert_still_serving(env, bridge, drive=True)
+    # Far below the floor and flung: finite, so allowed; reset_world and reset_simulation both bring it back.
+    for reset in ("reset_world", "reset_simulation"):
+        response = call(env, "set_model_state", "{model_state: {model_name: good, pose: {position: {z: -50}}, "
+                                                "twist: {linear: {x: 9000}, angular: {y: 9000}}}}")
+        assert response["success"] is True, response
+        call(env, reset)
+        wait_until(lambda: abs(model_pose(env, "good")[2] - spawn_z) < 0.05, 30,
+                   "%s to put the mbot back on the floor" % reset)
+        assert math.hypot(*model_pose(env, "good")[:2]) < 0.5
+        assert_still_serving(env, bridge, drive=True)
+
+
+# -- 5: a missing mesh names the file, the link and the model ---------------------------------------------------
+def _with_mesh(urdf, kind, filename):
+    root = ElementTree.fromstring(urdf)
+    link = root.find("link[@name='base_link']")
+    element = ElementTree.SubElement(link, kind)
+    geometry = ElementTree.SubElement(element, "geometry")
+    ElementTree.SubElement(geometry, "mesh", filename=filename)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def test_missing_collision_mesh_names_file_link_and_model(env, bridge, tmp_path, mbot_urdf):
+    missing = str(tmp_path / "missing.stl")
+    result = spawn(env, tmp_path, "bad", _with_mesh(mbot_urdf, "collision", missing))
+    assert_refused(result, "bad", "model 'bad'", "link 'base_link'", missing)
+    assert "bad" not in model_names(env)
+    assert_still_serving(env, bridge)
+
+
+def test_missing_visual_mesh_is_left_out_with_a_warning(env, bridge, tmp_path, mbot_urdf):
+    missing = str(tmp_path / "missing_visual.dae")
+    result = spawn(env, tmp_path, "shown", _with_mesh(without_namespace(mbot_urdf), "visual", missing),
+                   "-robot_namespace", "/shown", "-x", "3")
+    assert result.returncode == 0, result.stderr
+    wait_until(lambda: missing in open(bridge.log_path).read(), 10, "the warning in the bridge's log")
+    one_line(open(bridge.log_path).read(), "model 'shown'", "link 'base_link'", missing, "left out")
+    assert "shown" in model_names(env)
+    assert_still_serving(env, bridge)
+    assert call(env, "delete_model", "{model_name: shown}")["success"]  # the next tests share the bridge
+
+
+# -- 6: NaN in an SDF <pose> says NaN ---------------------------------------------------------------------------
+NAN_POSE_SDF = """<sdf version='1.6'><model name='box'><pose>nan 0 1 0 0 0</pose><link name='l'>
+  <collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link></model></sdf>"""
+
+
+def test_nan_in_sdf_pose_says_nan(env, bridge, tmp_path):
+    result = spawn(env, tmp_path, "bad", NAN_POSE_SDF, kind="-sdf")
+    assert_refused(result, "bad", "<pose>", "NaN is not a valid value")
+    assert "bad" not in model_names(env)
+    assert_still_serving(env, bridge)
+
+
+def test_nan_in_world_pose_stops_the_bridge_with_one_line(ros_env, tmp_path):
+    world = tmp_path / "nan.world"
+    world.write_text("<sdf version='1.6'><world name='w'>%s</world></sdf>"
+                     % NAN_POSE_SDF.replace("<sdf version='1.6'>", "").replace("</sdf>", ""))
+    result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false", "world_name:=%s" % world,
+                  "server_required:=true"], ros_env, timeout=REFUSAL_TIMEOUT)
+    one_line(result.stdout + result.stderr, "[FATAL]", "nan.world", "NaN is not a valid value")
+
+
+# -- 7: a FIFO as a mesh or world is refused without being opened ------------------------------------------------
+@pytest.fixture
+def fifo(tmp_path):
+    path = tmp_path / "mesh.stl"
+    os.mkfifo(path)
+    yield str(path)
+    # Should anything have opened it, a writer lets it go.
+    descriptor = None
+    try:
+        descriptor = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
+    except OSError:
+        pass
+    if descriptor is not None:
+        os.close(descriptor)
+
+
+def test_fifo_mesh_is_refused_unopened(env, bridge, tmp_path, mbot_urdf, fifo):
+    started = time.monotonic()
+    result = spawn(env, tmp_path, "bad", _with_mesh(mbot_urdf, "collision", fifo))
+    assert_refused(result, "bad", "model 'bad'", "link 'base_link'", fifo, "not a regular file")
+    assert time.monotonic() - started < REFUSAL_TIMEOUT
+    assert_still_serving(env, bridge)
+
+
+def test_fifo_mesh_in_sdf_model_is_refused_unopened(env, bridge, tmp_path, fifo):
+    sdf = NAN_POSE_SDF.replace("nan 0 1", "0 0 1")
+    sdf = sdf.replace("<box><size>1 1 1</size></box>", "<mesh><uri>file://%s</uri></mesh>" % fifo)
+    result = spawn(env, tmp_path, "bad", sdf, kind="-sdf")
+    # The collision that needs it is skipped with a warning; with no other collision the model is refused.
+    assert_refused(result, "bad", "model 'bad' has no collision geometry")
+    one_line(open(bridge.log_path).read(), fifo, "not a regular file")
+    assert_still_serving(env, bridge)
+
+
+def test_fifo_world_is_refused_and_the_bridge_stops(ros_env, tmp_path):
+    world = tmp_path / "fifo.world"
+    os.mkfifo(world)
+    try:
+        result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
+                      "world_name:=%s" % world, "server_required:=true"], ros_env, timeout=REFUSAL_TIMEOUT)
+    finally:
+        try:
+            os.close(os.open(world, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:
+            pass
+    # Refused before anything reads it (the launcher only looks for regular files); the run ends by itself.
+    one_line(result.stdout + result.stderr, str(world))
+    assert "REQUIRED process [gazebo-1] has died" in result.stdout + result.stderr
+
+
+# -- a sample of the fuzzing through ROS: garbage requests get success false, and the bridge carries on ----------
+GARBAGE_CALLS = [
+    ("set_model_state", "{model_state: {model_name: nowhere}}", "does not exist"),
+    ("set_model_state", "{model_state: {model_name: good, reference_frame: nowhere}}", "nowhere"),
+    ("get_model_state", "{model_name: nowhere}", "nowhere"),
+    ("delete_model", "{model_name: nowhere}", "does not exist"),
+    ("spawn_urdf_model", "{model_name: junk, model_xml: '<robot'}", "not valid XML"),
+    ("spawn_urdf_model", "{model_name: junk, model_xml: '<robot name=\"r\"/>'}", "has no <link>"),
+    ("spawn_urdf_model", "{model_name: good, model_xml: '<robot name=\"r\"><link name=\"a\"/></robot>'}",
+     "already exists"),
+    ("spawn_sdf_model", "{model_name: junk, model_xml: '<sdf version=\"1.6\"><model name=\"m\"><pose>0 0 inf 0 0 0"
+     "</pose></model></sdf>'}", "infinity is not a valid value"),
+    ("spawn_urdf_model", "{model_name: junk, model_xml: '<robot name=\"r\"><link name=\"a\"/></robot>', "
+     "initial_pose: {position: {z: -.inf}}}", "not a finite number"),
+]
+
+
+def test_garbage_service_calls_are_refused_and_the_bridge_carries_on(env, bridge):
+    for service, request, expected in GARBAGE_CALLS:
+        response = call(env, service, request)
+        assert response["success"] is False, (service, request, response)
+        assert expected in response["status_message"] and "\n" not in response["status_message"], response
+    assert "junk" not in model_names(env)
+    assert_still_serving(env, bridge)
+
+
+def test_set_model_state_with_an_overflowing_quaternion(env, bridge):
+    # Its squared norm overflows: normalised (to w = 1) or refused with one line, never a NaN pose.
+    response = call(env, "set_model_state", "{model_state: {model_name: good, pose: {orientation: "
+                                            "{w: 1.5e+154}}}}")
+    assert response["success"] or "\n" not in response["status_message"], response
+    assert all(math.isfinite(v) for v in model_pose(env, "good"))

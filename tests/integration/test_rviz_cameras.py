@@ -1,0 +1,97 @@
+"""rviz shows what the course's camera and kinect see: their launch files (gui:=false) with the shipped
+mbot_with_camera / mbot_with_kinect configs, on a private X server with software OpenGL.
+
+The camera picture is recognised by its sky: the bridge draws Gazebo's background grey (178, 178, 178)
+where nothing is in view, a colour neither rviz's panels nor its 3D view use. The 3D view must show the
+robot, and for the kinect also the point cloud in front of it. MBOT_SCREENSHOT_DIR, if set, receives a
+copy of each screenshot.
+"""
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+import rosgraph
+import yaml
+from mbot_gazebo.processes import stop_process_group
+
+from ros_processes import TESTS, wait_until
+from test_rviz import base_link_colour, colour_count, node_registered, parse_colour, published, view_3d, watch
+from xvfb import Xvfb
+
+CONFIG_DIR = os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config")
+SKY = np.array((178, 178, 178))
+MIN_SKY_PIXELS = 2000  # the image panel's picture, upper part
+MIN_ROBOT_PIXELS = 100
+MIN_CLOUD_PIXELS = 2000
+CASES = {
+    "camera": ("view_mbot_with_camera_gazebo.launch", "mbot_with_camera.rviz", {"/camera/image_raw"}),
+    "kinect": ("view_mbot_with_kinect_gazebo.launch", "mbot_with_kinect.rviz",
+               {"/kinect/rgb/image_raw", "/kinect/depth/points"}),
+}
+
+
+def sky_pixels(image):
+    """Pixels of the camera picture's sky (noise of a few levels allowed) anywhere on the screen."""
+    return int(np.all(np.abs(image.astype(int) - SKY) <= 8, axis=2).sum())
+
+
+def cloud_pixels(view):
+    """3D-view pixels in the picture's greys (the kinect's cloud takes the colours of what it sees: the play
+    ground's grey floor and barriers); the dark background, the half-transparent grid and the coloured robot
+    and TF axes are outside that range."""
+    pixels = view.astype(int)
+    spread = pixels.max(axis=2) - pixels.min(axis=2)
+    return int(((spread < 12) & (pixels.min(axis=2) >= 120) & (pixels.max(axis=2) <= 200)).sum())
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
+    launch_file, config_name, topics = CASES[case]
+    config = os.path.join(CONFIG_DIR, config_name)
+    with open(config) as stream:
+        displays = yaml.safe_load(stream)["Visualization Manager"]
+    background = parse_colour(displays["Global Options"]["Background Color"])
+
+    simulation = launch("mbot_gazebo", launch_file, "gui:=false")
+    master = rosgraph.Master("/test_rviz_cameras", master_uri=ros_env["ROS_MASTER_URI"])
+    wait_until(lambda: published(master) >= topics | {"/odom", "/tf"}, 90,
+               "%s and /odom, /tf (see %s)" % (", ".join(sorted(topics)), simulation.log_path))
+    robot_colour = base_link_colour(master.getParam("/robot_description"))
+
+    def drawn(image):
+        view = view_3d(image, background)
+        return (sky_pixels(image) >= MIN_SKY_PIXELS and view is not None
+                and colour_count(view, robot_colour) >= MIN_ROBOT_PIXELS
+                and (case != "kinect" or cloud_pixels(view) >= MIN_CLOUD_PIXELS))
+
+    screenshot = tmp_path / ("rviz_" + config_name.replace(".rviz", ".png"))
+    log_path = tmp_path / "rviz.log"
+    with Xvfb(tmp_path / "xvfb.log") as server:
+        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+        with open(log_path, "w") as log:
+            rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+                                    stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                    start_new_session=True)
+        try:
+            wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 60,
+                       "rviz to register with the master")
+            # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
+            image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image), 120, 2.0)
+        finally:
+            stop_process_group(rviz)
+    if os.environ.get("MBOT_SCREENSHOT_DIR"):
+        os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
+        shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
+    where = "(screenshot %s, rviz output %s)" % (screenshot, log_path)
+    view = view_3d(image, background)
+    assert view is not None, "no 3D view " + where
+    sky, robot = sky_pixels(image), colour_count(view, robot_colour)
+    cloud = cloud_pixels(view)
+    print("figure: rviz %s: %d picture-sky pixels, %d robot pixels, %d cloud pixels in the 3D view"
+          % (case, sky, robot, cloud))
+    assert sky >= MIN_SKY_PIXELS, "the camera picture is not in rviz's image panel " + where
+    assert robot >= MIN_ROBOT_PIXELS, "the robot is not in the 3D view " + where
+    if case == "kinect":
+        assert cloud >= MIN_CLOUD_PIXELS, "the point cloud is not in the 3D view " + where

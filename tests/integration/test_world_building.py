@@ -1,0 +1,136 @@
+"""The tutorial's first way to build an environment: insert models by name, arrange them, "Save world as", and
+load the saved world again (./mbot insert, move, delete, save-world; /gazebo/save_world)."""
+import json
+import math
+import os
+import xml.etree.ElementTree as ET
+
+import pytest
+from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.core.sdf_world import parse_world
+
+from ros_processes import TESTS, run, wait_until
+
+WORLDS = os.path.join(os.path.dirname(TESTS), "worlds")
+POSITION_TOLERANCE = 1e-3  # m
+ANGLE_TOLERANCE = 1e-3  # rad
+START_TIMEOUT = 90  # s: the bridge on a loaded two-core machine
+
+
+def service_up(ros_env, name):
+    return name in run(["rosservice", "list"], ros_env).stdout.split()
+
+
+def start_bridge(ros_env, launch, *arguments):
+    bridge = launch("mbot_sim_bridge", "empty_world.launch", "gui:=false", *arguments)
+    wait_until(lambda: service_up(ros_env, "/gazebo/save_world"), START_TIMEOUT, "the simulator's services")
+    return bridge
+
+
+def mbot_world(ros_env, *arguments):
+    return run(["rosrun", "mbot_gazebo", "mbot_world", *arguments], ros_env)
+
+
+def ok(result):
+    assert result.returncode == 0, result.stdout + result.stderr
+    return result.stdout
+
+
+def model_poses(ros_env):
+    output = ok(run(["python3", os.path.join(TESTS, "nodes", "model_poses.py")], ros_env))
+    return {name: (tuple(values[:3]), tuple(values[3:])) for name, values in json.loads(output).items()}
+
+
+def paused(ros_env):
+    return "pause: True" in ok(run(["rosservice", "call", "/gazebo/get_physics_properties"], ros_env))
+
+
+def angle_between(a, b):
+    return 2.0 * math.acos(min(1.0, abs(sum(x * y for x, y in zip(a, b)))))
+
+
+def assert_same_poses(actual, expected):
+    assert sorted(actual) == sorted(expected)
+    for name, (position, orientation) in expected.items():
+        distance = math.dist(actual[name][0], position)
+        angle = angle_between(actual[name][1], orientation)
+        assert distance < POSITION_TOLERANCE and angle < ANGLE_TOLERANCE, (
+            "%s: %.4f m and %.4f rad from its saved pose" % (name, distance, angle))
+
+
+def relaunch(ros_env, launch, running, world):
+    """Stop the running simulator, start one paused on ``world``: the poses it reports are those it loaded."""
+    stop_process_group(running)
+    wait_until(lambda: not service_up(ros_env, "/gazebo/save_world"), 30, "the first simulator to stop")
+    start_bridge(ros_env, launch, "world_name:=%s" % world, "paused:=true")
+
+
+def test_insert_move_save_and_relaunch_finds_every_model_where_it_was(ros_env, launch, tmp_path):
+    bridge = start_bridge(ros_env, launch)
+    ok(mbot_world(ros_env, "insert", "cafe_table", "-x", "2", "-y", "1"))
+    ok(mbot_world(ros_env, "insert", "unit_box", "-x", "-1", "-y", "2", "-Y", "0.5"))
+    assert "as 'unit_box_0'" in ok(mbot_world(ros_env, "insert", "unit_box", "-x", "-2", "-y", "-2"))
+    ok(mbot_world(ros_env, "insert", "construction_barrel", "--as", "barrel", "-x", "3", "-y", "-1"))
+    ok(mbot_world(ros_env, "insert", "coke_can", "-x", "4"))
+    ok(mbot_world(ros_env, "delete", "coke_can"))
+    ok(mbot_world(ros_env, "move", "unit_box_0", "-x", "0", "-y", "-3", "-Y", "1.0"))
+    # Paused, nothing settles further between reading the poses and saving them.
+    ok(run(["rosservice", "call", "/gazebo/pause_physics"], ros_env))
+    before = model_poses(ros_env)
+    assert sorted(before) == ["barrel", "cafe_table", "ground_plane", "unit_box", "unit_box_0"]
+    assert math.dist(before["unit_box_0"][0][:2], (0.0, -3.0)) < POSITION_TOLERANCE
+    saved = tmp_path / "arranged.world"
+    assert "wrote %s" % saved in ok(mbot_world(ros_env, "save-world", str(saved)))
+
+    root = ET.parse(saved).getroot()
+    assert root.get("version") == "1.6"
+    includes = {include.findtext("name"): include.findtext("uri") for include in root.iter("include")
+                if include.find("name") is not None}
+    assert includes == {"ground_plane": "model://ground_plane", "cafe_table": "model://cafe_table",
+                        "unit_box": "model://unit_box", "unit_box_0": "model://unit_box",
+                        "barrel": "model://construction_barrel"}
+
+    relaunch(ros_env, launch, bridge, saved)
+    assert_same_poses(model_poses(ros_env), before)
+
+
+def test_play_ground_saved_and_reloaded_keeps_every_pose_robot_left_out(ros_env, launch, tmp_path):
+    course = launch("mbot_gazebo", "view_mbot_gazebo_play_ground.launch", "gui:=false", "paused:=true")
+    wait_until(lambda: "mbot" in model_poses(ros_env), START_TIMEOUT, "the mbot to be spawned")
+    before = model_poses(ros_env)
+    saved, with_robot = tmp_path / "play_ground.world", tmp_path / "play_ground_with_mbot.world"
+    assert "robots left out" in ok(mbot_world(ros_env, "save-world", str(saved)))
+    assert "plugins are kept as <plugin> tags" in ok(mbot_world(ros_env, "save-world", str(with_robot),
+                                                                "--with-robots"))
+    assert ET.parse(saved).getroot().find("world/model[@name='mbot']") is None
+    assert ET.parse(with_robot).getroot().find("world/model[@name='mbot']") is not None
+    # The robot's model frame is its root link, where get_model_state puts it too.
+    robot = next(model for model in parse_world(str(with_robot)).models if model.name == "mbot")
+    assert_same_poses({"mbot": (robot.pose.position, robot.pose.orientation)}, {"mbot": before["mbot"]})
+
+    relaunch(ros_env, launch, course, saved)
+    assert_same_poses(model_poses(ros_env), {name: pose for name, pose in before.items() if name != "mbot"})
+
+
+def test_bad_input_one_line_each_and_paused_stays_paused(ros_env, launch, tmp_path):
+    start_bridge(ros_env, launch, "paused:=true")
+    unknown = mbot_world(ros_env, "insert", "cafe_tabel")
+    assert unknown.returncode == 1
+    (line,) = unknown.stderr.strip().splitlines()
+    assert line.startswith("mbot_world: no model 'cafe_tabel' on the model path; nearest: cafe_table, table")
+
+    assert "as 'unit_sphere'" in ok(mbot_world(ros_env, "insert", "unit_sphere", "-z", "2"))
+    assert paused(ros_env)
+    assert model_poses(ros_env)["unit_sphere"][0] == pytest.approx((0.0, 0.0, 2.0), abs=1e-6)  # no fall: paused
+
+    for target in (tmp_path / "missing" / "out.world", tmp_path):
+        failed = mbot_world(ros_env, "save-world", str(target))
+        assert failed.returncode == 1
+        (line,) = [line for line in failed.stderr.splitlines() if line.startswith("mbot_world:")]
+        assert line.startswith("mbot_world: save-world failed: cannot write %s" % target)
+    assert not [name for name in os.listdir(tmp_path) if name.endswith(".tmp")]
+    assert not (tmp_path / "missing").exists()
+
+    moved = mbot_world(ros_env, "move", "no_such_model", "-x", "1")
+    assert moved.returncode == 1 and "cannot move 'no_such_model'" in moved.stderr
+    assert paused(ros_env)

@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Two-joint arms reach position setpoints within a degree through ros_control: /effort_arm with
+effort_controllers/JointPositionController (PID to effort), /position_arm with
+position_controllers/JointGroupPositionController. Joint angles come from each arm's joint_state_controller."""
+import math
+import sys
+import unittest
+
+import rospy
+import rostest
+from controller_manager_msgs.srv import ListControllers
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64, Float64MultiArray
+
+from sim_support import WALL_TIMEOUT, wait_for
+
+SETPOINTS = ((0.5, -0.8), (-1.0, 1.2), (1.5, 0.3))
+TOLERANCE_DEGREES = 1.0
+
+
+class RosControlArms(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("ros_control_arms_test")
+        cls.figures = []
+        cls.states = {}
+        for arm, controllers in (("effort_arm", 3), ("position_arm", 2)):
+            service = "/%s/controller_manager/list_controllers" % arm
+            rospy.wait_for_service(service, timeout=WALL_TIMEOUT)
+            listing = rospy.ServiceProxy(service, ListControllers)
+            wait_for(lambda: [c.state for c in listing().controller] == ["running"] * controllers,
+                     what="the %s spawner to start its controllers" % arm)
+            rospy.Subscriber("/%s/joint_states" % arm, JointState,
+                             lambda message, arm=arm: cls.states.__setitem__(arm, message))
+        wait_for(lambda: len(cls.states) == 2, what="joint_states of both arms")
+
+    @classmethod
+    def tearDownClass(cls):
+        print("\n".join([""] + ["figure: " + line for line in cls.figures]), file=sys.stderr)
+
+    def errors(self, arm, setpoint):
+        state = self.states[arm]
+        positions = dict(zip(state.name, state.position))
+        return [math.degrees(abs(positions[joint] - target)) for joint, target in zip(("shoulder", "elbow"), setpoint)]
+
+    def reach(self, arm, setpoint):
+        """Wait (sim time passes at its own pace) until both joints are within tolerance; return the errors."""
+        wait_for(lambda: max(self.errors(arm, setpoint)) < TOLERANCE_DEGREES, timeout=WALL_TIMEOUT,
+                 what="%s to reach %s" % (arm, setpoint))
+        # Still there a second of sim time later: settled, not passing through.
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() > start + 1.0, what="1 s of sim time")
+        errors = self.errors(arm, setpoint)
+        self.assertLess(max(errors), TOLERANCE_DEGREES, "%s at %s: errors %s degrees" % (arm, setpoint, errors))
+        return errors
+
+    def test_effort_arm_through_pid_position_controllers(self):
+        shoulder = rospy.Publisher("/effort_arm/shoulder_position_controller/command", Float64, queue_size=1,
+                                   latch=True)
+        elbow = rospy.Publisher("/effort_arm/elbow_position_controller/command", Float64, queue_size=1, latch=True)
+        for setpoint in SETPOINTS:
+            shoulder.publish(Float64(setpoint[0]))
+            elbow.publish(Float64(setpoint[1]))
+            errors = self.reach("effort_arm", setpoint)
+            self.figures.append("effort arm (effort_controllers/JointPositionController) at %s rad: errors %.3f, "
+                                "%.3f degrees" % (setpoint, *errors))
+
+    def test_position_arm_through_the_forward_group_controller(self):
+        command = rospy.Publisher("/position_arm/arm_controller/command", Float64MultiArray, queue_size=1,
+                                  latch=True)
+        for setpoint in SETPOINTS:
+            command.publish(Float64MultiArray(data=list(setpoint)))
+            errors = self.reach("position_arm", setpoint)
+            self.figures.append("position arm (position_controllers/JointGroupPositionController) at %s rad: "
+                                "errors %.3f, %.3f degrees" % (setpoint, *errors))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_tests", "ros_control_arms", RosControlArms)

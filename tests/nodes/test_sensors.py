@@ -1,0 +1,163 @@
+#!/usr/bin/env python3
+"""The sensor set on its topics: the course's kinect (rgb, depth, cloud, camera_info; a wall at 1.5 m read
+through the depth image and, after TF, through the cloud), the course's camera (image, camera_info, a red
+plate where K says), and TurtleBot3-style IMUs with p3d ground truth."""
+import math
+import sys
+import threading
+import unittest
+from types import SimpleNamespace
+
+import numpy
+import rospy
+import rostest
+import tf2_ros
+from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import CameraInfo, Image, Imu, PointCloud2
+
+from sim_support import WALL_TIMEOUT, Simulator, wait_for, yaw_of
+
+WALL_X = 1.65  # the wall's near face in the world (sensor_wall.world)
+PLATE = (2.495, 4.4, 0.3)  # the red plate's near-face centre
+# camera_link in base_footprint: base_link at z = 0.005/2 + 2 * 0.01975, camera 0.17 ahead, 0.10 above it.
+CAMERA_IN_BASE = numpy.array([0.17, 0.0, 0.0025 + 0.0395 + 0.10])
+
+
+class Collector:
+    def __init__(self, topic, message_type):
+        self.lock = threading.Lock()
+        self.messages = []
+        self.subscriber = rospy.Subscriber(topic, message_type, self.on_message, queue_size=5, buff_size=2 ** 26)
+
+    def on_message(self, message):
+        with self.lock:
+            self.messages.append(message)
+            del self.messages[:-40]
+
+    def wait(self, count=1):
+        wait_for(lambda: len(self.messages) >= count, what="%d messages on %s" % (count, self.subscriber.name))
+        with self.lock:
+            return list(self.messages)
+
+
+class Kinect(unittest.TestCase):
+    """kinect.test: the course's kinect robot alone, so that its TF tree is the odom one."""
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("kinect_test")
+        cls.sim = Simulator()
+        cls.tf = tf2_ros.Buffer()
+        cls.tf_listener = tf2_ros.TransformListener(cls.tf)
+
+    def test_kinect_topics_fields_and_rates(self):
+        rgb, depth = Collector("/kinect/rgb/image_raw", Image), Collector("/kinect/depth/image_raw", Image)
+        info = Collector("/kinect/rgb/camera_info", CameraInfo)
+        images, depths, infos = rgb.wait(4), depth.wait(4), info.wait(4)
+        image, info_message = images[-1], infos[-1]
+        self.assertEqual((image.width, image.height, image.encoding), (640, 480, "rgb8"))
+        self.assertEqual(image.header.frame_id, "kinect_frame_optical")
+        self.assertEqual((depths[-1].encoding, depths[-1].step), ("32FC1", 640 * 4))
+        self.assertAlmostEqual(info_message.K[0], 554.256, places=2)
+        self.assertEqual((info_message.K[2], info_message.K[5]), (320.5, 240.5))
+        depth_period = numpy.diff([m.header.stamp.to_sec() for m in depths]).min()
+        info_period = numpy.diff([m.header.stamp.to_sec() for m in infos]).min()
+        print("figure: kinect depth images every %.3f s of sim time, camera_info every %.3f s"
+              % (depth_period, info_period))
+        self.assertAlmostEqual(depth_period, 0.05, places=3)
+        self.assertAlmostEqual(info_period, 0.1, places=3)
+
+    def test_wall_in_the_depth_image_and_in_the_cloud_through_tf(self):
+        depth = Collector("/kinect/depth/image_raw", Image).wait(2)[-1]
+        values = numpy.frombuffer(depth.data, dtype=numpy.float32).reshape(480, 640)
+        centre = values[220:260, 300:340]
+        cloud = Collector("/kinect/depth/points", PointCloud2).wait(2)[-1]
+        points = numpy.frombuffer(cloud.data, dtype=numpy.float32).reshape(480, 640, 8)[..., :3]
+        transform = self.tf.lookup_transform("odom", cloud.header.frame_id, cloud.header.stamp,
+                                             rospy.Duration(WALL_TIMEOUT))
+        t, q = transform.transform.translation, transform.transform.rotation
+        rotation = quaternion_matrix((q.x, q.y, q.z, q.w))
+        world = points[200:280:10, 280:360:10].reshape(-1, 3) @ rotation.T + (t.x, t.y, t.z)
+        print("figure: kinect wall at 1.5 m: depth %.4f..%.4f m over the centre; cloud points at x %.4f..%.4f m "
+              "in odom (wall at %.2f)" % (numpy.nanmin(centre), numpy.nanmax(centre), world[:, 0].min(),
+                                          world[:, 0].max(), WALL_X))
+        self.assertLess(numpy.nanmax(numpy.abs(centre - 1.5)), 0.01)
+        self.assertLess(numpy.abs(world[:, 0] - WALL_X).max(), 0.01)
+        self.assertEqual((cloud.point_step, cloud.width, cloud.height), (32, 640, 480))
+        self.assertEqual([f.name for f in cloud.fields], ["x", "y", "z", "rgb"])
+
+
+class CameraAndImu(unittest.TestCase):
+    """sensors.test: the course's camera robot and an IMU robot, each in its own namespace."""
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("sensors_test")
+        # No Simulator(): it drives /cmd_vel, and these robots listen in their own namespaces.
+        rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
+        cls.sim = SimpleNamespace(get_model_state=rospy.ServiceProxy("/gazebo/get_model_state", GetModelState))
+        properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
+        for model in ("camera_bot", "imu_bot"):
+            wait_for(lambda: model in properties().model_names, what="model " + model)
+
+    def test_camera_image_and_the_red_plate_where_k_says(self):
+        # spawn_model's robot namespace comes first: NodeHandle("camera_bot" + "/" + "/camera"), as in Gazebo.
+        image = Collector("/camera_bot/camera/image_raw", Image).wait(1)[-1]
+        info = Collector("/camera_bot/camera/camera_info", CameraInfo).wait(1)[-1]
+        self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
+                         (1280, 720, "rgb8", "camera_link"))
+        self.assertAlmostEqual(info.K[0], 762.72, places=2)
+        self.assertAlmostEqual(info.P[3], -762.72 * 0.07, places=2)
+        pixels = numpy.frombuffer(image.data, dtype=numpy.uint8).reshape(720, 1280, 3).astype(int)
+        red = (pixels[..., 0] > 150) & (pixels[..., 1] < 80) & (pixels[..., 2] < 80)
+        rows, cols = numpy.nonzero(red)
+        x, y, z = self.plate_in_camera()
+        predicted = (info.K[0] * x / z + info.K[2], info.K[4] * y / z + info.K[5])
+        error = math.hypot(cols.mean() - predicted[0], rows.mean() - predicted[1])
+        print("figure: camera red plate predicted at (%.1f, %.1f) px, seen at (%.1f, %.1f) px: %.2f px apart"
+              % (predicted[0], predicted[1], cols.mean(), rows.mean(), error))
+        self.assertGreater(red.sum(), 50)
+        self.assertLess(error, 2.0)
+
+    def plate_in_camera(self):
+        """The plate's near-face centre in camera_link's optical convention (x right, y down, z forward)."""
+        pose = self.sim.get_model_state("camera_bot", "world").pose
+        q = pose.orientation
+        rotation = quaternion_matrix((q.x, q.y, q.z, q.w))
+        camera = numpy.array([pose.position.x, pose.position.y, pose.position.z]) + rotation @ CAMERA_IN_BASE
+        local = rotation.T @ (numpy.asarray(PLATE) - camera)
+        return -local[1], -local[2], local[0]
+
+    def test_imus_and_ground_truth(self):
+        imu = Collector("/imu_bot/imu", Imu).wait(20)
+        sensor = Collector("/imu_bot/imu_sensor", Imu).wait(20)
+        truth = Collector("/imu_bot/ground_truth", Odometry).wait(5)[-1]
+        state = self.sim.get_model_state("imu_bot", "world")
+        imu_period = numpy.diff([m.header.stamp.to_sec() for m in imu]).min()
+        accel_z = numpy.mean([m.linear_acceleration.z for m in sensor])
+        print("figure: imu_bot: libgazebo_ros_imu every %.3f s, frame %s, acceleration z %.3f; imu sensor "
+              "acceleration z %.3f m/s^2, yaw %.4f (truth %.4f); p3d x %.4f (model state %.4f)"
+              % (imu_period, imu[-1].header.frame_id, imu[-1].linear_acceleration.z, accel_z,
+                 yaw_of(sensor[-1].orientation), yaw_of(state.pose.orientation), truth.pose.pose.position.x,
+                 state.pose.position.x))
+        self.assertAlmostEqual(imu_period, 0.01, places=3)
+        self.assertEqual(imu[-1].header.frame_id, "base_footprint")  # sdformat renames the lumped imu_link
+        self.assertEqual(sensor[-1].header.frame_id, "imu_link")
+        self.assertLess(abs(imu[-1].linear_acceleration.z), 0.05)
+        self.assertLess(abs(accel_z - 9.8), 3 * 0.017)
+        self.assertLess(abs(yaw_of(sensor[-1].orientation) - 0.7), 0.01)
+        self.assertEqual((truth.header.frame_id, truth.child_frame_id), ("world", "base_footprint"))
+        self.assertAlmostEqual(truth.pose.pose.position.y, state.pose.position.y, places=3)
+
+
+def quaternion_matrix(q):
+    x, y, z, w = q
+    return numpy.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+if __name__ == "__main__":
+    case = Kinect if "Kinect" in sys.argv else CameraAndImu
+    rostest.rosrun("mbot_tests", case.__name__.lower(), case, sys.argv)
