@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from typing import Dict, NamedTuple, Optional, Sequence, Tuple, Type
 from xml.parsers import expat
 
-from .errors import BridgeError, ConfigError, WorldError
+from .errors import BridgeError, WorldError
 from .geometry import IDENTITY, Pose, pose_from_xyz_rpy
 
 _TRUE = ("true", "1")
@@ -206,8 +206,3 @@ def read_origin(parent: ET.Element, document: XmlDocument) -> Pose:
         return IDENTITY
     return pose_from_xyz_rpy(read_attribute_numbers(origin, "xyz", document, (0.0, 0.0, 0.0)),
                              read_attribute_numbers(origin, "rpy", document, (0.0, 0.0, 0.0)))
-
-
-def plugin_document(element: ET.Element, label: str) -> XmlDocument:
-    """A ``<plugin>`` or ``<sensor>`` block read on its own: errors are ConfigErrors naming ``label``."""
-    return XmlDocument(label, element, {}, ConfigError)
