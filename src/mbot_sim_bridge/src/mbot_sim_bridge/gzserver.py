@@ -77,12 +77,15 @@ def bridge_arguments(prog: str, argv, gui: bool = None):
         _note(prog, "physics profile %s is not supported; the world's <physics> is used" % options.profile)
     if options.physics != "ode":
         _note(prog, "-e %s: the bridge's engine is always Bullet" % options.physics)
-    search_path = default_resource_path()
-    # An absolute path goes to the bridge as it is: a missing or bad file is the bridge's one fatal line.
-    world = options.world if os.path.isabs(options.world) else find_world_file(options.world, search_path)
-    if world is None:
-        raise CommandLineError("world file %s not found here nor on the resource path %s"
-                               % (options.world, ":".join(search_path)))
+    # An absolute path goes to the bridge as it is: a missing or bad file is the bridge's one fatal line. Only a
+    # relative one needs the resource path (a rospack run, which can take a while when its cache is cold).
+    world = options.world
+    if not os.path.isabs(world):
+        search_path = default_resource_path()
+        world = find_world_file(options.world, search_path)
+        if world is None:
+            raise CommandLineError("world file %s not found here nor on the resource path %s"
+                                   % (options.world, ":".join(search_path)))
     # Private params set on the command line override the launch file's and any left on the master by an
     # earlier run; values are JSON, which rospy reads as YAML.
     params = {"world_name": world, "paused": options.pause}
