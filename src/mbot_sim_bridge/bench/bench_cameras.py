@@ -110,10 +110,7 @@ def camera_rtf(urdf: str, sim_seconds: float) -> float:
             serialized(image)
 
         camera.update = update_and_serialize
-        sim.step(200)
-        start = time.perf_counter()
-        sim.step(int(round(sim_seconds / sim.step_size)))
-        return sim_seconds / (time.perf_counter() - start)
+        return timed_rtf(sim, sim_seconds)
     finally:
         sim.close()
 
@@ -136,12 +133,17 @@ def imu_rtf(urdf: str, sim_seconds: float, with_imu: bool) -> float:
                 plugin.update = update_and_serialize
             if isinstance(plugin, DiffDrive):
                 plugin.set_command(0.2, 0.3)
-        sim.step(200)
-        start = time.perf_counter()
-        sim.step(int(round(sim_seconds / sim.step_size)))
-        return sim_seconds / (time.perf_counter() - start)
+        return timed_rtf(sim, sim_seconds)
     finally:
         sim.close()
+
+
+def timed_rtf(sim, sim_seconds: float) -> float:
+    """Real-time factor over ``sim_seconds``, after 200 steps that let the robot settle."""
+    sim.step(200)
+    start = time.perf_counter()
+    sim.step(int(round(sim_seconds / sim.step_size)))
+    return sim_seconds / (time.perf_counter() - start)
 
 
 def median_of(runs, function, *args):
