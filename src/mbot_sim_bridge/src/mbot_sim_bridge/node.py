@@ -11,7 +11,7 @@ import sys
 import threading
 import time
 from concurrent.futures import Future
-from typing import Callable
+from typing import Callable, Optional
 
 import pybullet
 import rospkg
@@ -90,7 +90,7 @@ class SimBridgeNode:
         self.api = GazeboRosApi(self)
 
     # -- called from ROS threads -------------------------------------------------------------------------
-    def call_in_loop(self, function: Callable, timeout: float = 30.0):
+    def call_in_loop(self, function: Callable, timeout: Optional[float] = 30.0):
         """Run ``function`` in the loop's thread (the only one that touches the engine) and return its result."""
         future: Future = Future()
         self._requests.put((function, future))

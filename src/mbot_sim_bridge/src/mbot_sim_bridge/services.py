@@ -6,6 +6,7 @@ thread (``node.call_in_loop``) and the result back into a response.
 import math
 import re
 import tempfile
+from typing import Optional
 from xml.etree import ElementTree
 
 import rospkg
@@ -100,10 +101,10 @@ class GazeboRosApi:
             return EmptyResponse()
         return handle
 
-    def _guarded(self, response_type, action):
+    def _guarded(self, response_type, action, timeout: Optional[float] = 30.0):
         """Run ``action`` in the loop thread; a BridgeError becomes success=false with its message."""
         try:
-            return self.node.call_in_loop(action)
+            return self.node.call_in_loop(action, timeout)
         except BridgeError as error:
             rospy.logerr(str(error))
             return response_type(success=False, status_message=str(error))
@@ -167,7 +168,8 @@ class GazeboRosApi:
             self.node.step(request.steps)
             return StepSimulationResponse(success=True, sim_time=self.sim.sim_time,
                                           status_message="StepSimulation: %d steps done" % request.steps)
-        return self._guarded(StepSimulationResponse, step)
+        # No time limit: the caller asked for that many steps and waits for them, however long they take.
+        return self._guarded(StepSimulationResponse, step, timeout=None)
 
     # -- state queries ---------------------------------------------------------------------------------------
     def _reference_pose(self, frame: str) -> Pose:
