@@ -1,6 +1,8 @@
-"""Start-up behaviour seen from the command line: paused:=true holds /clock, unknown plugins warn once."""
+"""Start-up behaviour seen from the command line: paused:=true holds /clock, unknown plugins warn once,
+spawn_model waits for the simulator (or gives up after -timeout with one line)."""
 import subprocess
 
+from mbot_gazebo.processes import stop_process_group
 from ros_processes import run, wait_until
 
 
@@ -40,3 +42,35 @@ def test_unknown_plugin_warns_once_and_the_model_still_spawns(ros_env, launch, t
     assert clock_message(ros_env, timeout=30) is not None, "the simulation carries on"
     warnings = [line for line in bridge.log_path.read_text().splitlines() if "libgazebo_ros_teleporter.so" in line]
     assert len(warnings) == 1 and "[WARN]" in warnings[0] and "is not emulated" in warnings[0], warnings
+
+
+GADGET = "<robot name='gadget'><link name='body'/></robot>"
+
+
+def test_spawn_model_started_first_waits_for_the_simulator(ros_env, launch, tmp_path):
+    model = tmp_path / "gadget.urdf"
+    model.write_text(GADGET)
+    spawner = subprocess.Popen(["rosrun", "mbot_sim_bridge", "spawn_model", "-urdf", "-file", str(model),
+                                "-model", "gadget"], env=ros_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               text=True, start_new_session=True)
+    try:
+        wait_until(lambda: spawner.poll() is not None or any(
+            name.startswith("/spawn_model") for name in run(["rosnode", "list"], ros_env).stdout.split()),
+            30, "spawn_model's node")
+        assert spawner.poll() is None, "spawn_model exited before the simulator was up: " + spawner.stdout.read()
+        launch("mbot_sim_bridge", "empty_world.launch", "gui:=false")
+        output, _ = spawner.communicate(timeout=60)
+    finally:
+        stop_process_group(spawner)
+    assert spawner.returncode == 0, output
+    assert "spawned 'gadget'" in output
+
+
+def test_spawn_model_timeout_without_a_simulator_is_one_line(ros_env, tmp_path):
+    model = tmp_path / "gadget.urdf"
+    model.write_text(GADGET)
+    result = run(["rosrun", "mbot_sim_bridge", "spawn_model", "-urdf", "-file", str(model), "-model", "gadget",
+                  "-timeout", "0.5"], ros_env)
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr, result.stderr
+    assert "spawn_model: service /gazebo/spawn_urdf_model did not appear within 0.5 s (-timeout)" in result.stderr

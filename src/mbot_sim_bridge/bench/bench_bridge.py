@@ -3,12 +3,14 @@
 
 (a) raw PyBullet: the course's mbot driven by the core's diff-drive loop in the empty world, no ROS;
 (b) the bridge: mbot_gazebo's mbot_world.launch (the mbot in the empty world) at real-time factor 0 with every
-topic subscribed; the real-time factor of each and their ratio, and the wall time from roslaunch to the first /odom;
+topic subscribed; the real-time factor of each and their ratio, and the wall time from roslaunch to the first /odom
+(median of several launches);
 then ten robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
 (bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
 """
 import argparse
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -53,47 +55,63 @@ def raw_pybullet_rtf(sim_seconds: float) -> float:
     return sim_seconds / elapsed
 
 
-def bridge_figures(wall_seconds: float):
-    """(real-time factor, seconds from roslaunch to the first /odom, topics subscribed), every topic subscribed."""
-    with PrivateMaster() as master:
-        os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
-        rospy.init_node("bench_bridge", disable_signals=True)
-        started = time.monotonic()
-        launch = subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false",
-                                   "real_time_factor:=0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                  start_new_session=True)
-        try:
-            rospy.wait_for_message("/odom", Odometry, timeout=120)
-            first_odom = time.monotonic() - started
-            clock = []
-            subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
-                                                                                    m.clock.to_sec())))]
-            # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
-            subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
-                            for topic, _ in rospy.get_published_topics() if topic != "/clock"]
-            time.sleep(1.0)  # let every subscription connect before the measured window
-            window_start = len(clock)
-            time.sleep(wall_seconds)
-            (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
-            for subscriber in subscribers:
-                subscriber.unregister()
-            return (sim1 - sim0) / (wall1 - wall0), first_odom, len(subscribers)
-        finally:
-            stop_process_group(launch)
+def _launch(*arguments):
+    return subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false", "real_time_factor:=0",
+                             *arguments], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+def first_odom_seconds() -> float:
+    """Wall time from roslaunch to the first /odom: one launch, stopped again."""
+    started = time.monotonic()
+    launch = _launch()
+    try:
+        rospy.wait_for_message("/odom", Odometry, timeout=120)
+        return time.monotonic() - started
+    finally:
+        stop_process_group(launch)
+
+
+def bridge_rtf(wall_seconds: float):
+    """(real-time factor, topics subscribed) of one launch with every topic subscribed."""
+    launch = _launch()
+    try:
+        rospy.wait_for_message("/odom", Odometry, timeout=120)
+        clock = []
+        subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
+                                                                                m.clock.to_sec())))]
+        # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
+        subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
+                        for topic, _ in rospy.get_published_topics() if topic != "/clock"]
+        time.sleep(1.0)  # let every subscription connect before the measured window
+        window_start = len(clock)
+        time.sleep(wall_seconds)
+        (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
+        for subscriber in subscribers:
+            subscriber.unregister()
+        return (sim1 - sim0) / (wall1 - wall0), len(subscribers)
+    finally:
+        stop_process_group(launch)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sim-seconds", type=float, default=20.0, help="sim time of the raw PyBullet run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time the bridge is measured")
+    parser.add_argument("--launches", type=int, default=7, help="launches timed to the first /odom")
     args = parser.parse_args()
 
     raw = raw_pybullet_rtf(args.sim_seconds)
     print("raw PyBullet real-time factor: %.2f" % raw, flush=True)
-    bridge, first_odom, topics = bridge_figures(args.wall_seconds)
-    print("bridge real-time factor (%d topics subscribed): %.2f" % (topics, bridge))
-    print("bridge / raw: %.2f" % (bridge / raw))
-    print("roslaunch to first /odom: %.2f s" % first_odom, flush=True)
+    with PrivateMaster() as master:
+        os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy and the launches
+        rospy.init_node("bench_bridge", disable_signals=True)
+        bridge, topics = bridge_rtf(args.wall_seconds)
+        print("bridge real-time factor (%d topics subscribed): %.2f" % (topics, bridge))
+        print("bridge / raw: %.2f" % (bridge / raw))
+        # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several.
+        launches = sorted(first_odom_seconds() for _ in range(args.launches))
+        print("roslaunch to first /odom: median %.2f s (%d launches, %.2f to %.2f s)"
+              % (statistics.median(launches), len(launches), launches[0], launches[-1]), flush=True)
     # The others, each in a process of its own (each starts its own master and rospy node).
     for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_cameras.py"):
         status = subprocess.call([sys.executable, os.path.join(HERE, script)])

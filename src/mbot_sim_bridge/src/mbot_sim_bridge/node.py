@@ -188,6 +188,10 @@ def main():
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
+    # Running flat out, the loop thread holds the GIL between steps; every hand-off to a ROS thread (a subscriber
+    # connecting, a service call, cmd_vel) then waits out the switch interval, and a connection takes dozens of
+    # them: at the default 5 ms a new subscriber at real_time_factor 0 waited up to half a second (bench).
+    sys.setswitchinterval(0.001)
     verbose = "--verbose" in rospy.myargv(sys.argv)[1:]
     rospy.init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO, disable_signals=True)
     try:
