@@ -24,7 +24,7 @@ def launch(ros_env, tmp_path):
     processes = []
 
     def start(*arguments):
-        log_path = tmp_path / ("roslaunch-%d.log" % len(processes))
+        log_path = tmp_path / (f"roslaunch-{len(processes)}.log")
         with open(log_path, "w") as log:
             process = subprocess.Popen(["roslaunch", *arguments], env=ros_env, stdout=log,
                                        stderr=subprocess.STDOUT, start_new_session=True)

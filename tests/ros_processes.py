@@ -12,7 +12,7 @@ def wait_until(condition, timeout, what):
         if condition():
             return
         time.sleep(0.05)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
+    raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
 
 
 def run(command, environment, timeout=90, stdin=None):

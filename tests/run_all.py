@@ -55,7 +55,7 @@ def run_pytest(selected, ignored):
 
 
 def run_rostest(test_file):
-    print("== rostest %s" % os.path.relpath(test_file, ROOT), flush=True)
+    print(f"== rostest {os.path.relpath(test_file, ROOT)}", flush=True)
     started = time.monotonic()
     result = subprocess.run(["rostest", "--text", test_file], cwd=ROOT, capture_output=True, text=True)
     output = result.stdout + result.stderr
@@ -72,7 +72,7 @@ def run_rostest(test_file):
     failed = (int(errors[-1]) + int(failures[-1])) if tests else 1
     if result.returncode != 0 and failed == 0:
         failed = 1
-    print("   %d tests, %d failed (%.0f s)" % (total, failed, time.monotonic() - started), flush=True)
+    print(f"   {total} tests, {failed} failed ({time.monotonic() - started:.0f} s)", flush=True)
     return total - min(failed, total), failed
 
 
@@ -87,7 +87,7 @@ def main():
         file_passed, file_failed = run_rostest(test_file)
         passed += file_passed
         failed += file_failed
-    print("summary: %d passed, %d failed" % (passed, failed))
+    print(f"summary: {passed} passed, {failed} failed")
     return 1 if failed else 0
 
 

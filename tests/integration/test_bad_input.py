@@ -14,7 +14,7 @@ BAD_DRIVE = """<robot name="lopsided">
 def one_error_line(output, *expected):
     assert "Traceback" not in output, output
     lines = [line for line in output.splitlines() if all(text in line for text in expected)]
-    assert lines, "no line containing %s in:\n%s" % (expected, output)
+    assert lines, f"no line containing {expected} in:\n{output}"
 
 
 def spawn(ros_env, *arguments):
@@ -74,5 +74,5 @@ def test_bridge_with_malformed_world_names_file_and_line(ros_env, tmp_path):
     world = tmp_path / "broken.world"
     world.write_text("<?xml version='1.0'?>\n<sdf version='1.6'>\n<world name='w'>\n</sdf>\n")
     result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
-                  "world_name:=%s" % world, "server_required:=true"], ros_env)
+                  f"world_name:={world}", "server_required:=true"], ros_env)
     one_error_line(result.stdout + result.stderr, "[FATAL]", "broken.world:4")

@@ -38,6 +38,6 @@ def test_demo_tours_the_play_ground_and_draws_its_odometry(ros_env, tmp_path):
         patch = pixels[max(row - 2, 0):row + 3, max(column - 2, 0):column + 3]
         drawn += bool(np.any(np.abs(patch - colour).sum(axis=2) < 60))
     assert len(visible) > 100
-    assert drawn >= 0.98 * len(visible), "%d of %d odometry points are on the drawn path" % (drawn, len(visible))
+    assert drawn >= 0.98 * len(visible), f"{drawn} of {len(visible)} odometry points are on the drawn path"
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         Image.open(picture).save(os.path.join(os.environ["MBOT_SCREENSHOT_DIR"], "demo.png"))

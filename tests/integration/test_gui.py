@@ -26,9 +26,9 @@ def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):
     with Xvfb(tmp_path / "xvfb.log") as server:
         ros_env.update(DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1")
         simulation = launch("mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=true")
-        wait_until(lambda: spawned(ros_env), 90, "the mbot to spawn (see %s)" % simulation.log_path)
+        wait_until(lambda: spawned(ros_env), 90, f"the mbot to spawn (see {simulation.log_path})")
         wait_until(lambda: gazebo_blue_pixels(server.screenshot(screenshot)) >= MIN_ROBOT_PIXELS, 60,
-                   "the blue mbot in the window (screenshot %s)" % screenshot)
+                   f"the blue mbot in the window (screenshot {screenshot})")
         if os.environ.get("MBOT_SCREENSHOT_DIR"):
             server.screenshot(os.path.join(os.environ["MBOT_SCREENSHOT_DIR"], "pybullet_gui.png"))
     assert "GUI" in simulation.log_path.read_text()

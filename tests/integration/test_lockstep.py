@@ -38,7 +38,7 @@ def bridge_only(recording, zero_seq=False):
 
 
 def summary(recording):
-    return ", ".join("%s from %s: %d" % (topic, node, len(messages))
+    return ", ".join(f"{topic} from {node}: {len(messages)}"
                      for (topic, node), messages in sorted(recording.items()))
 
 
@@ -48,12 +48,12 @@ def test_lockstep_orders_commands_and_reruns_are_bit_identical(ros_env, launch, 
     recording = first["first"]
     for key in [("/odom", "/gazebo"), ("/scan", "/gazebo"), ("/joint_states", "/gazebo"), ("/tf", "/gazebo"),
                 ("/tf", "/robot_state_publisher")]:
-        assert len(recording.get(key, [])) > 10, "too few %s messages: %s" % (key, summary(recording))
-    print("figure: lockstep script recorded %s" % summary(recording))
+        assert len(recording.get(key, [])) > 10, f"too few {key} messages: {summary(recording)}"
+    print(f"figure: lockstep script recorded {summary(recording)}")
     assert bridge_only(first["after_reset"], True) == bridge_only(recording, True), \
         "reset_simulation did not repeat the run"
     second = recorded_run(ros_env, launch, tmp_path, "second")
     assert bridge_only(second["first"]) == bridge_only(recording), "a second launch of the same script differs"
     assert bridge_only(second["after_reset"]) == bridge_only(first["after_reset"])
-    print("figure: two launches and a reset: %d serialized messages of the bridge identical byte for byte"
-          % sum(len(messages) for messages in bridge_only(recording).values()))
+    identical = sum(len(messages) for messages in bridge_only(recording).values())
+    print(f"figure: two launches and a reset: {identical} serialized messages of the bridge identical byte for byte")

@@ -12,7 +12,7 @@ MBOT = os.path.join(os.path.dirname(TESTS), "mbot")
 
 def _environment(tmp_path):
     # A master of its own on a free port: ./mbot sim starts one when none answers.
-    return dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(), ROS_LOG_DIR=str(tmp_path))
+    return dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{free_port()}", ROS_LOG_DIR=str(tmp_path))
 
 
 def test_sim_with_a_missing_world_returns_the_simulators_status(tmp_path):

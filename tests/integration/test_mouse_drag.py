@@ -29,8 +29,8 @@ WALL_SECONDS = 8.0  # the simulation steps this long while the mouse works
 
 
 def insert(simulation, tmp_path, database_name, name, x, y):
-    xml = "<sdf version='1.6'><world name='w'><include><uri>model://%s</uri></include></world></sdf>" % database_name
-    path = tmp_path / ("%s.world" % name)
+    xml = f"<sdf version='1.6'><world name='w'><include><uri>model://{database_name}</uri></include></world></sdf>"
+    path = tmp_path / (f"{name}.world")
     path.write_text(spawn_world_xml(xml, name, pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, 0.0))))
     simulation.add_world(parse_world(str(path)))
 
@@ -108,7 +108,7 @@ def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulati
             break
     box = simulation.engine.model_pose("unit_box")
     moved = math.dist(box.position[:2], box_start[:2])
-    assert moved > 0.5, "the box moved %.3f m" % moved
+    assert moved > 0.5, f"the box moved {moved:.3f} m"
     assert np.dot(np.subtract(box.position[:2], box_start[:2]), DRAG_TO) > 0
     # The static table cannot be picked: the drag on it left it where it was.
     assert simulation.engine.model_pose("cafe_table") == table_start

@@ -25,7 +25,7 @@ REFUSAL_TIMEOUT = 45
 def one_line(output, *expected):
     assert "Traceback" not in output, output
     lines = [line for line in output.splitlines() if all(text in line for text in expected)]
-    assert lines, "no line containing %s in:\n%s" % (expected, output)
+    assert lines, f"no line containing {expected} in:\n{output}"
     return lines[0]
 
 
@@ -64,7 +64,7 @@ def without_namespace(urdf):
 
 
 def spawn(ros_env, tmp_path, name, xml, *arguments, kind="-urdf", timeout=REFUSAL_TIMEOUT):
-    path = tmp_path / ("%s.xml" % name)
+    path = tmp_path / (f"{name}.xml")
     path.write_text(xml)
     return run(["rosrun", "mbot_sim_bridge", "spawn_model", kind, "-model", name, "-file", str(path), *arguments],
                ros_env, timeout=timeout)
@@ -72,18 +72,18 @@ def spawn(ros_env, tmp_path, name, xml, *arguments, kind="-urdf", timeout=REFUSA
 
 def call(ros_env, service, request="{}", timeout=CALL_TIMEOUT):
     result = run(["rosservice", "call", "/gazebo/" + service, request], ros_env, timeout=timeout)
-    assert result.returncode == 0, "rosservice call %s failed:\n%s%s" % (service, result.stdout, result.stderr)
+    assert result.returncode == 0, f"rosservice call {service} failed:\n{result.stdout}{result.stderr}"
     return yaml.safe_load(result.stdout)
 
 
 def echo(ros_env, topic, timeout=CALL_TIMEOUT):
     result = run(["rostopic", "echo", "-n", "1", "--noarr", topic], ros_env, timeout=timeout)
-    assert result.returncode == 0, "no message on %s:\n%s" % (topic, result.stderr)
+    assert result.returncode == 0, f"no message on {topic}:\n{result.stderr}"
     return yaml.safe_load(result.stdout.split("\n---")[0])
 
 
 def model_pose(ros_env, name):
-    state = call(ros_env, "get_model_state", "{model_name: %s}" % name)
+    state = call(ros_env, "get_model_state", f"{{model_name: {name}}}")
     assert state["success"], state
     position = state["pose"]["position"]
     return tuple(float(position[axis]) for axis in "xyz")
@@ -144,8 +144,8 @@ def assert_still_serving(ros_env, bridge, drive=False):
 
 
 def assert_refused(result, name, *expected):
-    assert result.returncode == 1, "spawn of %s was not refused:\n%s%s" % (name, result.stdout, result.stderr)
-    return one_line(result.stderr, "spawn_model: spawning '%s' failed:" % name, *expected)
+    assert result.returncode == 1, f"spawn of {name} was not refused:\n{result.stdout}{result.stderr}"
+    return one_line(result.stderr, f"spawn_model: spawning '{name}' failed:", *expected)
 
 
 # -- 1, 2, 4: diff-drive tags that divide by zero or fly the robot off are refused at the door --------------------
@@ -170,7 +170,7 @@ def test_set_model_state_refuses_nan_and_reset_repairs(env, bridge):
     spawn_z = model_pose(env, "good")[2]
     for field in ("pose: {position: {x: .nan}}", "pose: {orientation: {w: .inf}}", "twist: {linear: {z: -.inf}}",
                   "pose: {position: {y: 1.0e+300}}"):
-        response = call(env, "set_model_state", "{model_state: {model_name: good, %s}}" % field)
+        response = call(env, "set_model_state", f"{{model_state: {{model_name: good, {field}}}}}")
         assert response["success"] is False, (field, response)
         assert "nothing was changed" in response["status_message"], response
         assert "\n" not in response["status_message"]
@@ -184,7 +184,7 @@ def test_set_model_state_refuses_nan_and_reset_repairs(env, bridge):
         assert response["success"] is True, response
         call(env, reset)
         wait_until(lambda: abs(model_pose(env, "good")[2] - spawn_z) < 0.05, 30,
-                   "%s to put the mbot back on the floor" % reset)
+                   f"{reset} to put the mbot back on the floor")
         assert math.hypot(*model_pose(env, "good")[:2]) < 0.5
         assert_still_serving(env, bridge, drive=True)
 
@@ -233,9 +233,9 @@ def test_nan_in_sdf_pose_says_nan(env, bridge, tmp_path):
 
 def test_nan_in_world_pose_stops_the_bridge_with_one_line(ros_env, tmp_path):
     world = tmp_path / "nan.world"
-    world.write_text("<sdf version='1.6'><world name='w'>%s</world></sdf>"
-                     % NAN_POSE_SDF.replace("<sdf version='1.6'>", "").replace("</sdf>", ""))
-    result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false", "world_name:=%s" % world,
+    model = NAN_POSE_SDF.replace("<sdf version='1.6'>", "").replace("</sdf>", "")
+    world.write_text(f"<sdf version='1.6'><world name='w'>{model}</world></sdf>")
+    result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false", f"world_name:={world}",
                   "server_required:=true"], ros_env, timeout=REFUSAL_TIMEOUT)
     one_line(result.stdout + result.stderr, "[FATAL]", "nan.world", "NaN is not a valid value")
 
@@ -266,7 +266,7 @@ def test_fifo_mesh_is_refused_unopened(env, bridge, tmp_path, mbot_urdf, fifo):
 
 def test_fifo_mesh_in_sdf_model_is_refused_unopened(env, bridge, tmp_path, fifo):
     sdf = NAN_POSE_SDF.replace("nan 0 1", "0 0 1")
-    sdf = sdf.replace("<box><size>1 1 1</size></box>", "<mesh><uri>file://%s</uri></mesh>" % fifo)
+    sdf = sdf.replace("<box><size>1 1 1</size></box>", f"<mesh><uri>file://{fifo}</uri></mesh>")
     result = spawn(env, tmp_path, "bad", sdf, kind="-sdf")
     # The collision that needs it is skipped with a warning; with no other collision the model is refused.
     assert_refused(result, "bad", "model 'bad' has no collision geometry")
@@ -279,7 +279,7 @@ def test_fifo_world_is_refused_and_the_bridge_stops(ros_env, tmp_path):
     os.mkfifo(world)
     try:
         result = run(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
-                      "world_name:=%s" % world, "server_required:=true"], ros_env, timeout=REFUSAL_TIMEOUT)
+                      f"world_name:={world}", "server_required:=true"], ros_env, timeout=REFUSAL_TIMEOUT)
     finally:
         try:
             os.close(os.open(world, os.O_WRONLY | os.O_NONBLOCK))

@@ -53,7 +53,7 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
     simulation = launch("mbot_gazebo", *launch_file, "gui:=false")
     master = rosgraph.Master("/test_rviz", master_uri=ros_env["ROS_MASTER_URI"])
     wait_until(lambda: published(master) >= topics, 60,
-               "the simulation's %s (see %s)" % (", ".join(sorted(topics)), simulation.log_path))
+               f"the simulation's {', '.join(sorted(topics))} (see {simulation.log_path})")
     robot_colour = base_link_colour(master.getParam(description))
 
     def drawn(image):
@@ -67,7 +67,7 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
         # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
         environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
         for attempt in range(1, RVIZ_ATTEMPTS + 1):
-            log_path = tmp_path / ("rviz-%d.log" % attempt)
+            log_path = tmp_path / (f"rviz-{attempt}.log")
             with open(log_path, "w") as log:
                 rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
                                         stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
@@ -84,24 +84,24 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
                 break
             # rviz 1.14 sometimes aborts in OGRE's start-up under software OpenGL (std::bad_alloc); that is
             # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
-            print("rviz exited with %s on start %d:\n%s" % (rviz.returncode, attempt, log_path.read_text()))
-        assert not crashed, "rviz exited with %s:\n%s" % (rviz.returncode, log_path.read_text())
+            print(f"rviz exited with {rviz.returncode} on start {attempt}:\n{log_path.read_text()}")
+        assert not crashed, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
         shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
 
-    where = "(screenshot %s, rviz output %s)" % (screenshot, log_path)
+    where = f"(screenshot {screenshot}, rviz output {log_path})"
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50, "the screen is blank " + where
     view = view_3d(image, background)
-    assert view is not None, "no 3D view with the background colour %s %s" % (background, where)
-    assert view.shape[0] > 300 and view.shape[1] > 300, "the 3D view is only %s pixels %s" % (view.shape[:2], where)
+    assert view is not None, f"no 3D view with the background colour {background} {where}"
+    assert view.shape[0] > 300 and view.shape[1] > 300, f"the 3D view is only {view.shape[:2]} pixels {where}"
     robot_pixels = colour_count(view, robot_colour)
-    assert robot_pixels >= MIN_ROBOT_PIXELS, "base_link colour %s on %d pixels of the 3D view %s" % (
-        robot_colour, robot_pixels, where)
+    assert robot_pixels >= MIN_ROBOT_PIXELS, \
+        f"base_link colour {robot_colour} on {robot_pixels} pixels of the 3D view {where}"
     if scan_colour is not None:
         scan_pixels = len(scan_pixels_off_robot(view, robot_colour, scan_colour))
-        assert scan_pixels >= MIN_SCAN_PIXELS, "LaserScan colour %s on %d pixels away from the robot %s" % (
-            scan_colour, scan_pixels, where)
+        assert scan_pixels >= MIN_SCAN_PIXELS, \
+            f"LaserScan colour {scan_colour} on {scan_pixels} pixels away from the robot {where}"
     output = log_path.read_text()
     tf_errors = [line for line in output.splitlines() if any(error in line for error in TF_ERRORS)]
     assert not tf_errors, "TF errors in rviz's output:\n" + "\n".join(tf_errors[:10])
@@ -127,7 +127,7 @@ def base_link_colour(robot_description):
     material = robot.find("link[@name='base_link']/visual/material")
     colour = material.find("color")
     if colour is None:
-        colour = robot.find("material[@name='%s']/color" % material.get("name"))
+        colour = robot.find(f"material[@name='{material.get('name')}']/color")
     return tuple(round(255 * float(value)) for value in colour.get("rgba").split()[:3])
 
 

@@ -57,7 +57,7 @@ def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
     simulation = launch("mbot_gazebo", launch_file, "gui:=false")
     master = rosgraph.Master("/test_rviz_cameras", master_uri=ros_env["ROS_MASTER_URI"])
     wait_until(lambda: published(master) >= topics | {"/odom", "/tf"}, 90,
-               "%s and /odom, /tf (see %s)" % (", ".join(sorted(topics)), simulation.log_path))
+               f"{', '.join(sorted(topics))} and /odom, /tf (see {simulation.log_path})")
     robot_colour = base_link_colour(master.getParam("/robot_description"))
 
     def drawn(image):
@@ -84,13 +84,12 @@ def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
         shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
-    where = "(screenshot %s, rviz output %s)" % (screenshot, log_path)
+    where = f"(screenshot {screenshot}, rviz output {log_path})"
     view = view_3d(image, background)
     assert view is not None, "no 3D view " + where
     sky, robot = sky_pixels(image), colour_count(view, robot_colour)
     cloud = cloud_pixels(view)
-    print("figure: rviz %s: %d picture-sky pixels, %d robot pixels, %d cloud pixels in the 3D view"
-          % (case, sky, robot, cloud))
+    print(f"figure: rviz {case}: {sky} picture-sky pixels, {robot} robot pixels, {cloud} cloud pixels in the 3D view")
     assert sky >= MIN_SKY_PIXELS, "the camera picture is not in rviz's image panel " + where
     assert robot >= MIN_ROBOT_PIXELS, "the robot is not in the 3D view " + where
     if case == "kinect":

@@ -15,7 +15,7 @@ from ros_processes import TESTS
 
 ROOT = os.path.dirname(TESTS)
 # A subnet of the veth pair only, inside namespaces this test makes; the pid keeps parallel runs apart.
-SUBNET = "10.200.%d" % (os.getpid() % 250 + 1)
+SUBNET = f"10.200.{os.getpid() % 250 + 1}"
 SIM_ADDRESS, WORKSTATION_ADDRESS = SUBNET + ".1", SUBNET + ".2"
 ARRIVAL_TIMEOUT = 180
 
@@ -49,19 +49,19 @@ def _ip(*arguments):
 def namespaces():
     """Two network namespaces joined by a veth pair; both deleted afterwards, whatever happened."""
     if os.geteuid() != 0:
-        pytest.skip("network namespaces need root; this test runs as uid %d" % os.geteuid())
+        pytest.skip(f"network namespaces need root; this test runs as uid {os.geteuid()}")
     if shutil.which("ip") is None:
         pytest.skip("no 'ip' command (iproute2) to make network namespaces")
     tag = os.getpid()
-    sim, workstation = "mbot_sim_%d" % tag, "mbot_ws_%d" % tag
+    sim, workstation = f"mbot_sim_{tag}", f"mbot_ws_{tag}"
     created = []
     try:
         for name in (sim, workstation):
             result = _ip("netns", "add", name)
             if result.returncode != 0:
-                pytest.skip("cannot make a network namespace: %s" % result.stderr.strip())
+                pytest.skip(f"cannot make a network namespace: {result.stderr.strip()}")
             created.append(name)
-        veth_sim, veth_workstation = "mbs%d" % tag, "mbw%d" % tag
+        veth_sim, veth_workstation = f"mbs{tag}", f"mbw{tag}"
         steps = [("link", "add", veth_sim, "netns", sim, "type", "veth", "peer", "name", veth_workstation,
                   "netns", workstation)]
         ends = ((sim, veth_sim, SIM_ADDRESS), (workstation, veth_workstation, WORKSTATION_ADDRESS))
@@ -71,7 +71,7 @@ def namespaces():
                       ("-n", name, "link", "set", device, "up")]
         for step in steps:
             result = _ip(*step)
-            assert result.returncode == 0, "ip %s: %s" % (" ".join(step), result.stderr)
+            assert result.returncode == 0, f"ip {' '.join(step)}: {result.stderr}"
         yield sim, workstation
     finally:
         for name in created:
@@ -80,7 +80,7 @@ def namespaces():
 
 def test_a_workstation_receives_scan_tf_and_clock(namespaces, tmp_path):
     sim, workstation = namespaces
-    master = "http://%s:11311" % SIM_ADDRESS
+    master = f"http://{SIM_ADDRESS}:11311"
     environment = dict(os.environ, ROS_MASTER_URI=master, ROS_LOG_DIR=str(tmp_path), PYTHONUNBUFFERED="1")
     log_path = tmp_path / "sim.log"
     with open(log_path, "w") as log:
@@ -94,7 +94,7 @@ def test_a_workstation_receives_scan_tf_and_clock(namespaces, tmp_path):
                                  str(ARRIVAL_TIMEOUT)], env=dict(environment, ROS_IP=WORKSTATION_ADDRESS),
                                 capture_output=True, text=True, timeout=ARRIVAL_TIMEOUT + 60)
         simulation_log = log_path.read_text()[-3000:]
-        assert client.returncode == 0, "%s%s\nsimulation:\n%s" % (client.stdout, client.stderr, simulation_log)
+        assert client.returncode == 0, f"{client.stdout}{client.stderr}\nsimulation:\n{simulation_log}"
         assert "arrived: /clock /scan /tf" in client.stdout
     finally:
         stop_process_group(simulation)

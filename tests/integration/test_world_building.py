@@ -55,14 +55,14 @@ def assert_same_poses(actual, expected):
         distance = math.dist(actual[name][0], position)
         angle = angle_between(actual[name][1], orientation)
         assert distance < POSITION_TOLERANCE and angle < ANGLE_TOLERANCE, (
-            "%s: %.4f m and %.4f rad from its saved pose" % (name, distance, angle))
+            f"{name}: {distance:.4f} m and {angle:.4f} rad from its saved pose")
 
 
 def relaunch(ros_env, launch, running, world):
     """Stop the running simulator, start one paused on ``world``: the poses it reports are those it loaded."""
     stop_process_group(running)
     wait_until(lambda: not service_up(ros_env, "/gazebo/save_world"), 30, "the first simulator to stop")
-    start_bridge(ros_env, launch, "world_name:=%s" % world, "paused:=true")
+    start_bridge(ros_env, launch, f"world_name:={world}", "paused:=true")
 
 
 def test_insert_move_save_and_relaunch_finds_every_model_where_it_was(ros_env, launch, tmp_path):
@@ -80,7 +80,7 @@ def test_insert_move_save_and_relaunch_finds_every_model_where_it_was(ros_env, l
     assert sorted(before) == ["barrel", "cafe_table", "ground_plane", "unit_box", "unit_box_0"]
     assert math.dist(before["unit_box_0"][0][:2], (0.0, -3.0)) < POSITION_TOLERANCE
     saved = tmp_path / "arranged.world"
-    assert "wrote %s" % saved in ok(mbot_world(ros_env, "save-world", str(saved)))
+    assert f"wrote {saved}" in ok(mbot_world(ros_env, "save-world", str(saved)))
 
     root = ET.parse(saved).getroot()
     assert root.get("version") == "1.6"
@@ -127,7 +127,7 @@ def test_bad_input_one_line_each_and_paused_stays_paused(ros_env, launch, tmp_pa
         failed = mbot_world(ros_env, "save-world", str(target))
         assert failed.returncode == 1
         (line,) = [line for line in failed.stderr.splitlines() if line.startswith("mbot_world:")]
-        assert line.startswith("mbot_world: save-world failed: cannot write %s" % target)
+        assert line.startswith(f"mbot_world: save-world failed: cannot write {target}")
     assert not [name for name in os.listdir(tmp_path) if name.endswith(".tmp")]
     assert not (tmp_path / "missing").exists()
 

@@ -57,7 +57,7 @@ class Xvfb:
             xwd = subprocess.Popen(["xwd", "-root", "-silent", "-display", self.display], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE)
             try:
-                convert = subprocess.run([CONVERT, "xwd:-", "png:%s" % png_path], stdin=xwd.stdout,
+                convert = subprocess.run([CONVERT, "xwd:-", f"png:{png_path}"], stdin=xwd.stdout,
                                          capture_output=True, timeout=self.timeout)
             finally:
                 xwd.stdout.close()
@@ -65,8 +65,8 @@ class Xvfb:
             if xwd.returncode == 0 and convert.returncode == 0:
                 with Image.open(png_path) as image:
                     return np.asarray(image.convert("RGB"))
-        raise RuntimeError("screenshot of %s failed %d times, last: %s%s" % (
-            self.display, attempts, xwd_error.decode(), convert.stderr.decode()))
+        raise RuntimeError(f"screenshot of {self.display} failed {attempts} times, last: "
+                           f"{xwd_error.decode()}{convert.stderr.decode()}")
 
     def _read_display_number(self, read_end) -> str:
         text = b""
@@ -74,8 +74,8 @@ class Xvfb:
             ready, _, _ = select.select([read_end], [], [], self.timeout)
             chunk = os.read(read_end, 16) if ready else b""
             if not chunk:
-                raise RuntimeError("Xvfb did not report a display within %.0f s (exit code %s); see %s"
-                                   % (self.timeout, self._process.poll(), self.log_path))
+                raise RuntimeError(f"Xvfb did not report a display within {self.timeout:.0f} s (exit code "
+                                   f"{self._process.poll()}); see {self.log_path}")
             text += chunk
         return text.decode().strip()
 

@@ -19,7 +19,7 @@ def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
         if value:
             return value
         time.sleep(0.01)
-    raise AssertionError("timed out after %.0f s waiting for %s" % (timeout, what))
+    raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
 
 
 def yaw_of(orientation):
@@ -48,7 +48,7 @@ class Simulator:
         self.reset_simulation = rospy.ServiceProxy("/gazebo/reset_simulation", Empty)
         self.pause = rospy.ServiceProxy("/gazebo/pause_physics", Empty)
         self.unpause = rospy.ServiceProxy("/gazebo/unpause_physics", Empty)
-        wait_for(lambda: model in self.world_properties().model_names, what="model '%s' to be spawned" % model)
+        wait_for(lambda: model in self.world_properties().model_names, what=f"model '{model}' to be spawned")
         self.cmd_vel = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
         wait_for(lambda: self.cmd_vel.get_num_connections() > 0, what="the simulator to subscribe /cmd_vel")
 
@@ -67,4 +67,4 @@ class Simulator:
         """Wait until ``seconds`` of sim time have passed; returns the ground truth then."""
         start = self.truth()[0]
         return wait_for(lambda: (lambda truth: truth if truth[0] >= start + seconds else None)(self.truth()),
-                        what="%.1f s of sim time" % seconds)
+                        what=f"{seconds:.1f} s of sim time")

@@ -31,8 +31,9 @@ class Barrier(unittest.TestCase):
         furthest = max(pose.position.x for _, pose, _ in track)
         highest = max(abs(pose.position.z) for _, pose, _ in track)
         tilt = max(abs(a) for _, pose, _ in track for a in roll_pitch_of(pose.orientation))
-        print("figure: barrier face at x=%.2f: robot front reached x=%.3f, |z| <= %.4f m, tilt <= %.2f deg"
-              % (BARRIER_NEAR_FACE_X, furthest + BASE_RADIUS, highest, math.degrees(tilt)), file=sys.stderr)
+        print(f"figure: barrier face at x={BARRIER_NEAR_FACE_X:.2f}: robot front reached "
+              f"x={furthest + BASE_RADIUS:.3f}, |z| <= {highest:.4f} m, tilt <= {math.degrees(tilt):.2f} deg",
+              file=sys.stderr)
         self.assertGreater(furthest + BASE_RADIUS, BARRIER_NEAR_FACE_X - 0.3, "it should reach the barrier")
         self.assertLess(furthest + BASE_RADIUS, BARRIER_NEAR_FACE_X + 0.01, "it must not pass through")
         self.assertLess(highest, 0.05, "it must stay on the ground")

@@ -27,8 +27,8 @@ class DriveTracking(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join(["", "figure: tracking, from ground truth %.0f s after each command, over %.0f s:"
-                         % (SETTLE_SECONDS, MEASURE_SECONDS)] + ["figure: " + line for line in cls.figures]),
+        print("\n".join(["", f"figure: tracking, from ground truth {SETTLE_SECONDS:.0f} s after each command, over "
+                             f"{MEASURE_SECONDS:.0f} s:"] + ["figure: " + line for line in cls.figures]),
               file=sys.stderr)
 
     def steady_motion(self, linear, angular):
@@ -48,26 +48,26 @@ class DriveTracking(unittest.TestCase):
         return speed, yaw_rate, tilt, z
 
     def check_level(self, tilt, z):
-        self.assertLess(z, 0.01, "the robot left the ground: |z| = %.4f m" % z)
-        self.assertLess(math.degrees(tilt), 2.0, "the robot tilted %.2f degrees" % math.degrees(tilt))
+        self.assertLess(z, 0.01, f"the robot left the ground: |z| = {z:.4f} m")
+        self.assertLess(math.degrees(tilt), 2.0, f"the robot tilted {math.degrees(tilt):.2f} degrees")
 
     def test_linear_speed_tracks_the_command(self):
         for linear in (0.1, 0.2, 0.5, -0.2):
             speed, yaw_rate, tilt, z = self.steady_motion(linear, 0.0)
-            self.figures.append("  v=%+.2f m/s: measured %+.4f m/s (%+.2f%%), yaw rate %+.4f rad/s, tilt %.3f deg, "
-                                "|z| %.4f m" % (linear, speed, 100 * (speed - linear) / abs(linear), yaw_rate,
-                                                math.degrees(tilt), z))
-            self.assertAlmostEqual(speed, linear, delta=0.05 * abs(linear), msg="v=%.2f" % linear)
+            self.figures.append(f"  v={linear:+.2f} m/s: measured {speed:+.4f} m/s "
+                                f"({100 * (speed - linear) / abs(linear):+.2f}%), yaw rate {yaw_rate:+.4f} rad/s, tilt "
+                                f"{math.degrees(tilt):.3f} deg, |z| {z:.4f} m")
+            self.assertAlmostEqual(speed, linear, delta=0.05 * abs(linear), msg=f"v={linear:.2f}")
             self.check_level(tilt, z)
 
     def test_turning_in_place_tracks_the_command_counter_clockwise_positive(self):
         for angular in (0.5, 1.0, -1.0):
             speed, yaw_rate, tilt, z = self.steady_motion(0.0, angular)
-            self.figures.append("  w=%+.2f rad/s: measured %+.4f rad/s (%+.2f%%), tilt %.3f deg, |z| %.4f m"
-                                % (angular, yaw_rate, 100 * (yaw_rate - angular) / abs(angular),
-                                   math.degrees(tilt), z))
+            self.figures.append(f"  w={angular:+.2f} rad/s: measured {yaw_rate:+.4f} rad/s "
+                                f"({100 * (yaw_rate - angular) / abs(angular):+.2f}%), tilt "
+                                f"{math.degrees(tilt):.3f} deg, |z| {z:.4f} m")
             # Within 5% also fixes the sign: positive angular.z turns counter-clockwise (yaw grows).
-            self.assertAlmostEqual(yaw_rate, angular, delta=0.05 * abs(angular), msg="w=%.2f" % angular)
+            self.assertAlmostEqual(yaw_rate, angular, delta=0.05 * abs(angular), msg=f"w={angular:.2f}")
             self.check_level(tilt, z)
 
     def test_odometry_agrees_with_ground_truth_after_five_metres(self):
@@ -81,8 +81,8 @@ class DriveTracking(unittest.TestCase):
         odometry = rospy.wait_for_message("/odom", Odometry, timeout=30.0)
         error = math.hypot(odometry.pose.pose.position.x - pose.position.x,
                            odometry.pose.pose.position.y - pose.position.y)
-        self.figures.append("  after a %.3f m drive: |odom - ground truth| = %.5f m"
-                            % (math.hypot(pose.position.x, pose.position.y), error))
+        self.figures.append(f"  after a {math.hypot(pose.position.x, pose.position.y):.3f} m drive: |odom - "
+                            f"ground truth| = {error:.5f} m")
         self.assertLess(error, 0.01)
         self.assertEqual((odometry.header.frame_id, odometry.child_frame_id), ("odom", "base_footprint"))
 

@@ -42,7 +42,7 @@ class Laser(unittest.TestCase):
 
     def scans_after(self, count, start=0.0):
         wait_for(lambda: len([s for s in self.scans if s.header.stamp.to_sec() > start]) >= count,
-                 what="%d scans" % count)
+                 what=f"{count} scans")
         with self.lock:
             return [s for s in self.scans if s.header.stamp.to_sec() > start]
 
@@ -63,7 +63,7 @@ class Laser(unittest.TestCase):
         scans = self.scans_after(23)
         stamps = numpy.array([s.header.stamp.to_sec() for s in scans])
         rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
-        print("figure: scan rate %.4f Hz in sim time over %d scans (expected %.1f)" % (rate, len(stamps), SCAN_RATE),
+        print(f"figure: scan rate {rate:.4f} Hz in sim time over {len(stamps)} scans (expected {SCAN_RATE:.1f})",
               file=sys.stderr)
         self.assertAlmostEqual(rate, SCAN_RATE, delta=0.02 * SCAN_RATE)
         self.assertTrue(numpy.all(numpy.diff(stamps) > 0), "stamps must advance")
@@ -78,8 +78,8 @@ class Laser(unittest.TestCase):
         ahead = numpy.abs(angles) < 0.3
         # The hit distance along a beam at angle a to the wall's normal is d / cos(a).
         errors = numpy.array(scan.ranges)[ahead] - WALL_DISTANCE / numpy.cos(angles[ahead])
-        print("figure: wall at %.2f m: mean error %.4f m, std %.4f m over %d beams"
-              % (WALL_DISTANCE, errors.mean(), errors.std(ddof=1), ahead.sum()), file=sys.stderr)
+        print(f"figure: wall at {WALL_DISTANCE:.2f} m: mean error {errors.mean():.4f} m, std {errors.std(ddof=1):.4f} "
+              f"m over {ahead.sum()} beams", file=sys.stderr)
         self.assertLess(abs(errors.mean()), 0.005)
         self.assertLess(errors.std(ddof=1), 0.02)
 
@@ -95,7 +95,7 @@ class Laser(unittest.TestCase):
         # The 10 m wall is seen over a span of beams symmetric about its normal; the span's middle is the
         # wall's direction, which noise cannot move the way it moves a single nearest beam.
         angle = angles[numpy.isfinite(ranges)].mean()
-        print("figure: after a +90 degree turn the wall is centred at %.1f degrees" % math.degrees(angle),
+        print(f"figure: after a +90 degree turn the wall is centred at {math.degrees(angle):.1f} degrees",
               file=sys.stderr)
         # Beams count counter-clockwise from angle_min, so the wall, now on the robot's right, is at -90 degrees.
         self.assertAlmostEqual(angle, -math.pi / 2, delta=2.5 * scan.angle_increment)

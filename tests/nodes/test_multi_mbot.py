@@ -15,7 +15,7 @@ from sensor_msgs.msg import LaserScan
 from sim_support import WALL_TIMEOUT, wait_for, yaw_of
 
 COUNT = 10
-ROBOTS = ["mbot_%d" % index for index in range(1, COUNT + 1)]
+ROBOTS = [f"mbot_{index}" for index in range(1, COUNT + 1)]
 LASER_X = 0.08  # laser_link ahead of base_footprint (mbot_with_laser_gazebo.xacro)
 LIDAR_RADIUS = 0.05  # what another robot shows at the scan's height: its lidar's cylinder
 
@@ -26,14 +26,14 @@ class MultiMbot(unittest.TestCase):
         rospy.init_node("multi_mbot_test")
         rospy.wait_for_service("/gazebo/get_world_properties", timeout=WALL_TIMEOUT)
         world = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
-        wait_for(lambda: set(ROBOTS) <= set(world().model_names), timeout=240, what="%d robots" % COUNT)
+        wait_for(lambda: set(ROBOTS) <= set(world().model_names), timeout=240, what=f"{COUNT} robots")
         cls.state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
         cls.lock = threading.Lock()
         cls.odom, cls.scans = {}, {}
         cls.subscribers = []
         for robot in ROBOTS:
-            cls.subscribers.append(rospy.Subscriber("/%s/odom" % robot, Odometry, cls.keep(cls.odom, robot)))
-            cls.subscribers.append(rospy.Subscriber("/%s/scan" % robot, LaserScan, cls.keep(cls.scans, robot)))
+            cls.subscribers.append(rospy.Subscriber(f"/{robot}/odom", Odometry, cls.keep(cls.odom, robot)))
+            cls.subscribers.append(rospy.Subscriber(f"/{robot}/scan", LaserScan, cls.keep(cls.scans, robot)))
         wait_for(lambda: len(cls.odom) == COUNT and len(cls.scans) == COUNT, what="odom and scan of every robot")
 
     @classmethod
@@ -71,16 +71,16 @@ class MultiMbot(unittest.TestCase):
             measured = min(scan.ranges[max(0, beam - 2):beam + 3])
             error = measured - (math.hypot(dx, dy) - LIDAR_RADIUS)
             worst = max(worst, abs(error))
-            self.assertLess(abs(error), 0.06, "%s sees %s at %.3f m along %.2f rad, %.3f m off"
-                            % (robot, neighbour, measured, bearing, error))
-        print("figure: %d robots: each scan finds its nearest neighbour, worst error %.3f m" % (COUNT, worst))
+            self.assertLess(abs(error), 0.06, f"{robot} sees {neighbour} at {measured:.3f} m along "
+                                              f"{bearing:.2f} rad, {error:.3f} m off")
+        print(f"figure: {COUNT} robots: each scan finds its nearest neighbour, worst error {worst:.3f} m")
 
     def test_each_robot_drives_on_its_own_cmd_vel(self):
         rates = {robot: 0.1 * (index + 1) * (-1) ** index for index, robot in enumerate(ROBOTS)}
-        publishers = {robot: rospy.Publisher("/%s/cmd_vel" % robot, Twist, queue_size=1, latch=True)
+        publishers = {robot: rospy.Publisher(f"/{robot}/cmd_vel", Twist, queue_size=1, latch=True)
                       for robot in ROBOTS}
         for robot, publisher in publishers.items():
-            wait_for(lambda: publisher.get_num_connections() > 0, what="/%s/cmd_vel subscribed" % robot)
+            wait_for(lambda: publisher.get_num_connections() > 0, what=f"/{robot}/cmd_vel subscribed")
             command = Twist()
             command.angular.z = rates[robot]
             publisher.publish(command)
@@ -88,8 +88,8 @@ class MultiMbot(unittest.TestCase):
                  what="every robot turning at its own rate")
         for publisher in publishers.values():
             publisher.publish(Twist())
-        print("figure: %d robots turning at %s rad/s on their own cmd_vel"
-              % (COUNT, ", ".join("%.1f" % rate for rate in rates.values())))
+        turning = ", ".join(f"{rate:.1f}" for rate in rates.values())
+        print(f"figure: {COUNT} robots turning at {turning} rad/s on their own cmd_vel")
 
 
 if __name__ == "__main__":

@@ -54,7 +54,7 @@ class RoomScan(unittest.TestCase):
                     and shape.bounds()[0][2] <= LASER_POSITION[2] <= shape.bounds()[1][2]]
         scans = []
         subscriber = rospy.Subscriber("/scan", LaserScan, scans.append)
-        wait_for(lambda: len(scans) >= SCANS_AVERAGED, what="%d scans" % SCANS_AVERAGED)
+        wait_for(lambda: len(scans) >= SCANS_AVERAGED, what=f"{SCANS_AVERAGED} scans")
         subscriber.unregister()
         scan = scans[0]
         measured = numpy.array([s.ranges for s in scans[:SCANS_AVERAGED]])
@@ -68,8 +68,8 @@ class RoomScan(unittest.TestCase):
             checked += 1
             errors.append(measured[:, beam].mean() - expected[1])
         errors = numpy.abs(numpy.array(errors))
-        print("figure: room.world: %d beams on walls, |measured - SDF| mean %.4f m, max %.4f m"
-              % (checked, errors.mean(), errors.max()), file=sys.stderr)
+        print(f"figure: room.world: {checked} beams on walls, |measured - SDF| mean {errors.mean():.4f} m, max "
+              f"{errors.max():.4f} m", file=sys.stderr)
         self.assertGreater(checked, 200, "most beams should see a wall in the room")
         self.assertLess(errors.max(), TOLERANCE)
 

@@ -78,7 +78,7 @@ class RosApi(unittest.TestCase):
         for subscriber in subscribers:
             subscriber.unregister()
         for frame, senders in transform_senders.items():
-            self.assertEqual(len(senders), 1, "/tf child %s has several publishers: %s" % (frame, senders))
+            self.assertEqual(len(senders), 1, f"/tf child {frame} has several publishers: {senders}")
         self.assertEqual(transform_senders["base_footprint"], {"/gazebo"})
         self.assertEqual(transform_senders["left_wheel_link"], {"/robot_state_publisher"})
         for joint in ("left_wheel_joint", "right_wheel_joint", "back_caster_joint"):

@@ -25,12 +25,12 @@ class RosControlArms(unittest.TestCase):
         cls.figures = []
         cls.states = {}
         for arm, controllers in (("effort_arm", 3), ("position_arm", 2)):
-            service = "/%s/controller_manager/list_controllers" % arm
+            service = f"/{arm}/controller_manager/list_controllers"
             rospy.wait_for_service(service, timeout=WALL_TIMEOUT)
             listing = rospy.ServiceProxy(service, ListControllers)
             wait_for(lambda: [c.state for c in listing().controller] == ["running"] * controllers,
-                     what="the %s spawner to start its controllers" % arm)
-            rospy.Subscriber("/%s/joint_states" % arm, JointState,
+                     what=f"the {arm} spawner to start its controllers")
+            rospy.Subscriber(f"/{arm}/joint_states", JointState,
                              lambda message, arm=arm: cls.states.__setitem__(arm, message))
         wait_for(lambda: len(cls.states) == 2, what="joint_states of both arms")
 
@@ -46,12 +46,12 @@ class RosControlArms(unittest.TestCase):
     def reach(self, arm, setpoint):
         """Wait (sim time passes at its own pace) until both joints are within tolerance; return the errors."""
         wait_for(lambda: max(self.errors(arm, setpoint)) < TOLERANCE_DEGREES, timeout=WALL_TIMEOUT,
-                 what="%s to reach %s" % (arm, setpoint))
+                 what=f"{arm} to reach {setpoint}")
         # Still there a second of sim time later: settled, not passing through.
         start = rospy.get_time()
         wait_for(lambda: rospy.get_time() > start + 1.0, what="1 s of sim time")
         errors = self.errors(arm, setpoint)
-        self.assertLess(max(errors), TOLERANCE_DEGREES, "%s at %s: errors %s degrees" % (arm, setpoint, errors))
+        self.assertLess(max(errors), TOLERANCE_DEGREES, f"{arm} at {setpoint}: errors {errors} degrees")
         return errors
 
     def test_effort_arm_through_pid_position_controllers(self):
@@ -62,8 +62,8 @@ class RosControlArms(unittest.TestCase):
             shoulder.publish(Float64(setpoint[0]))
             elbow.publish(Float64(setpoint[1]))
             errors = self.reach("effort_arm", setpoint)
-            self.figures.append("effort arm (effort_controllers/JointPositionController) at %s rad: errors %.3f, "
-                                "%.3f degrees" % (setpoint, *errors))
+            self.figures.append(f"effort arm (effort_controllers/JointPositionController) at {setpoint} rad: errors "
+                                f"{errors[0]:.3f}, {errors[1]:.3f} degrees")
 
     def test_position_arm_through_the_forward_group_controller(self):
         command = rospy.Publisher("/position_arm/arm_controller/command", Float64MultiArray, queue_size=1,
@@ -71,8 +71,8 @@ class RosControlArms(unittest.TestCase):
         for setpoint in SETPOINTS:
             command.publish(Float64MultiArray(data=list(setpoint)))
             errors = self.reach("position_arm", setpoint)
-            self.figures.append("position arm (position_controllers/JointGroupPositionController) at %s rad: "
-                                "errors %.3f, %.3f degrees" % (setpoint, *errors))
+            self.figures.append(f"position arm (position_controllers/JointGroupPositionController) at {setpoint} rad: "
+                                f"errors {errors[0]:.3f}, {errors[1]:.3f} degrees")
 
 
 if __name__ == "__main__":

@@ -37,7 +37,7 @@ class GroundTruth:
         self.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
         self.reset_world = rospy.ServiceProxy("/gazebo/reset_world", Empty)
         properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
-        wait_for(lambda: model in properties().model_names, what="model '%s' to be spawned" % model)
+        wait_for(lambda: model in properties().model_names, what=f"model '{model}' to be spawned")
 
     def truth(self):
         state = self.get_model_state(self.model, "world")
@@ -46,7 +46,7 @@ class GroundTruth:
     def wait_sim_time(self, seconds):
         start = self.truth()[0]
         return wait_for(lambda: (lambda truth: truth if truth[0] >= start + seconds else None)(self.truth()),
-                        what="%.1f s of sim time" % seconds)
+                        what=f"{seconds:.1f} s of sim time")
 
 
 class RosControlMbot(unittest.TestCase):
@@ -66,9 +66,9 @@ class RosControlMbot(unittest.TestCase):
         wait_for(lambda: cls.states() == {"joint_state_controller": "running", CONTROLLER: "running"},
                  what="the spawner to start both controllers")
         cls.odometry = None
-        cls.odom_subscriber = rospy.Subscriber("/%s/odom" % CONTROLLER, Odometry,
+        cls.odom_subscriber = rospy.Subscriber(f"/{CONTROLLER}/odom", Odometry,
                                                lambda message: setattr(cls, "odometry", message))
-        cls.cmd_vel = rospy.Publisher("/%s/cmd_vel" % CONTROLLER, Twist, queue_size=1)
+        cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
         cls.twist = None
         cls.repeater = threading.Thread(target=cls.repeat_command, daemon=True)
@@ -113,8 +113,8 @@ class RosControlMbot(unittest.TestCase):
         for linear, angular in ((0.2, 0.0), (-0.2, 0.0), (0.0, 0.5), (0.0, -1.0)):
             speed, yaw_rate = self.steady_motion(linear, angular)
             commanded, measured = (linear, speed) if linear else (angular, yaw_rate)
-            self.figures.append("ros_control mbot v=%+.1f w=%+.1f: measured v %+.4f m/s, w %+.4f rad/s (%+.2f%%)"
-                                % (linear, angular, speed, yaw_rate, 100 * (measured - commanded) / abs(commanded)))
+            self.figures.append(f"ros_control mbot v={linear:+.1f} w={angular:+.1f}: measured v {speed:+.4f} m/s, w "
+                                f"{yaw_rate:+.4f} rad/s ({100 * (measured - commanded) / abs(commanded):+.2f}%)")
             self.assertAlmostEqual(measured, commanded, delta=0.05 * abs(commanded))
 
     def test_2_cmd_vel_timeout_stops_the_robot(self):
@@ -125,7 +125,7 @@ class RosControlMbot(unittest.TestCase):
         t0, pose0, _ = self.sim.wait_sim_time(1.0)
         t1, pose1, _ = self.sim.wait_sim_time(1.0)
         speed = math.hypot(pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y) / (t1 - t0)
-        self.figures.append("ros_control mbot after cmd_vel_timeout: %.5f m/s" % speed)
+        self.figures.append(f"ros_control mbot after cmd_vel_timeout: {speed:.5f} m/s")
         self.assertLess(speed, 0.005)
 
     def test_3_wheel_odometry_over_3_m(self):
@@ -141,8 +141,8 @@ class RosControlMbot(unittest.TestCase):
         odometry1, (_, truth1, _) = self.odometry.pose.pose.position, self.sim.truth()
         truth = math.hypot(truth1.position.x - truth0.position.x, truth1.position.y - truth0.position.y)
         odometry = math.hypot(odometry1.x - odometry0.x, odometry1.y - odometry0.y)
-        self.figures.append("ros_control mbot odometry over %.3f m of ground truth: %.3f m (%+.2f%%)"
-                            % (truth, odometry, 100 * (odometry - truth) / truth))
+        self.figures.append(f"ros_control mbot odometry over {truth:.3f} m of ground truth: {odometry:.3f} m "
+                            f"({100 * (odometry - truth) / truth:+.2f}%)")
         self.assertAlmostEqual(odometry, truth, delta=0.02 * truth)
 
     def test_4_switch_list_and_unload_as_upstream(self):

@@ -32,7 +32,7 @@ class RosControlQuad(unittest.TestCase):
                  what="the spawner to start both controllers")
         rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
         cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
-        cls.cmd_vel = rospy.Publisher("/%s/cmd_vel" % CONTROLLER, Twist, queue_size=1)
+        cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
 
     @classmethod
@@ -61,14 +61,14 @@ class RosControlQuad(unittest.TestCase):
         self.drive(0.4, 0.0, 2.0)
         pose1, elapsed = self.pose(), rospy.get_time() - start
         speed = math.hypot(pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y) / elapsed
-        self.figures.append("Husky-style quad base at 0.4 m/s: %.4f m/s" % speed)
+        self.figures.append(f"Husky-style quad base at 0.4 m/s: {speed:.4f} m/s")
         self.assertAlmostEqual(speed, 0.4, delta=0.02)
 
     def test_turns_left_on_positive_angular(self):
         yaw0 = yaw_of(self.pose().orientation)
         self.drive(0.0, 1.0, 1.5)
         turned = math.remainder(yaw_of(self.pose().orientation) - yaw0, 2 * math.pi)
-        self.figures.append("Husky-style quad base, 1.5 s at +1.0 rad/s: turned %+.3f rad" % turned)
+        self.figures.append(f"Husky-style quad base, 1.5 s at +1.0 rad/s: turned {turned:+.3f} rad")
         # Skid steering scrubs its wheels sideways, so it turns slower than asked (in Gazebo too); the direction
         # and a clear turn are what the launch file's setup decides.
         self.assertGreater(turned, 0.15)
@@ -77,7 +77,7 @@ class RosControlQuad(unittest.TestCase):
         message = rospy.wait_for_message("/joint_states", JointState, timeout=WALL_TIMEOUT)
         wait_for(lambda: {"front_left_wheel", "rear_left_wheel", "front_right_wheel", "rear_right_wheel"} <=
                  set(rospy.wait_for_message("/joint_states", JointState, timeout=WALL_TIMEOUT).name),
-                 what="the four wheels on /joint_states (last: %s)" % message.name)
+                 what=f"the four wheels on /joint_states (last: {message.name})")
 
     def test_spawner_yaml_file_stopped_and_shutdown(self):
         path = os.path.join(os.environ.get("ROS_LOG_DIR", "/tmp"), "quad_extra_controller.yaml")
@@ -98,7 +98,7 @@ class RosControlQuad(unittest.TestCase):
     def test_controller_manager_cli_lists_and_unspawner_inhibits(self):
         listing = subprocess.run(["rosrun", "controller_manager", "controller_manager", "list"], capture_output=True,
                                  text=True, timeout=WALL_TIMEOUT)
-        self.assertIn("'%s' - 'hardware_interface::VelocityJointInterface' ( running )" % CONTROLLER, listing.stdout)
+        self.assertIn(f"'{CONTROLLER}' - 'hardware_interface::VelocityJointInterface' ( running )", listing.stdout)
         unspawner = subprocess.Popen(["rosrun", "controller_manager", "unspawner", CONTROLLER],
                                      start_new_session=True)
         try:

@@ -36,7 +36,7 @@ class Collector:
             del self.messages[:-40]
 
     def wait(self, count=1):
-        wait_for(lambda: len(self.messages) >= count, what="%d messages on %s" % (count, self.subscriber.name))
+        wait_for(lambda: len(self.messages) >= count, what=f"{count} messages on {self.subscriber.name}")
         with self.lock:
             return list(self.messages)
 
@@ -63,8 +63,8 @@ class Kinect(unittest.TestCase):
         self.assertEqual((info_message.K[2], info_message.K[5]), (320.5, 240.5))
         depth_period = numpy.diff([m.header.stamp.to_sec() for m in depths]).min()
         info_period = numpy.diff([m.header.stamp.to_sec() for m in infos]).min()
-        print("figure: kinect depth images every %.3f s of sim time, camera_info every %.3f s"
-              % (depth_period, info_period))
+        print(f"figure: kinect depth images every {depth_period:.3f} s of sim time, camera_info "
+              f"every {info_period:.3f} s")
         self.assertAlmostEqual(depth_period, 0.05, places=3)
         self.assertAlmostEqual(info_period, 0.1, places=3)
 
@@ -79,9 +79,9 @@ class Kinect(unittest.TestCase):
         t, q = transform.transform.translation, transform.transform.rotation
         rotation = quaternion_matrix((q.x, q.y, q.z, q.w))
         world = points[200:280:10, 280:360:10].reshape(-1, 3) @ rotation.T + (t.x, t.y, t.z)
-        print("figure: kinect wall at 1.5 m: depth %.4f..%.4f m over the centre; cloud points at x %.4f..%.4f m "
-              "in odom (wall at %.2f)" % (numpy.nanmin(centre), numpy.nanmax(centre), world[:, 0].min(),
-                                          world[:, 0].max(), WALL_X))
+        print(f"figure: kinect wall at 1.5 m: depth {numpy.nanmin(centre):.4f}..{numpy.nanmax(centre):.4f} m over the "
+              f"centre; cloud points at x {world[:, 0].min():.4f}..{world[:, 0].max():.4f} m in "
+              f"odom (wall at {WALL_X:.2f})")
         self.assertLess(numpy.nanmax(numpy.abs(centre - 1.5)), 0.01)
         self.assertLess(numpy.abs(world[:, 0] - WALL_X).max(), 0.01)
         self.assertEqual((cloud.point_step, cloud.width, cloud.height), (32, 640, 480))
@@ -115,8 +115,8 @@ class CameraAndImu(unittest.TestCase):
         x, y, z = self.plate_in_camera()
         predicted = (info.K[0] * x / z + info.K[2], info.K[4] * y / z + info.K[5])
         error = math.hypot(cols.mean() - predicted[0], rows.mean() - predicted[1])
-        print("figure: camera red plate predicted at (%.1f, %.1f) px, seen at (%.1f, %.1f) px: %.2f px apart"
-              % (predicted[0], predicted[1], cols.mean(), rows.mean(), error))
+        print(f"figure: camera red plate predicted at ({predicted[0]:.1f}, {predicted[1]:.1f}) px, seen at "
+              f"({cols.mean():.1f}, {rows.mean():.1f}) px: {error:.2f} px apart")
         self.assertGreater(red.sum(), 50)
         self.assertLess(error, 2.0)
 
@@ -136,11 +136,10 @@ class CameraAndImu(unittest.TestCase):
         state = self.sim.get_model_state("imu_bot", "world")
         imu_period = numpy.diff([m.header.stamp.to_sec() for m in imu]).min()
         accel_z = numpy.mean([m.linear_acceleration.z for m in sensor])
-        print("figure: imu_bot: libgazebo_ros_imu every %.3f s, frame %s, acceleration z %.3f; imu sensor "
-              "acceleration z %.3f m/s^2, yaw %.4f (truth %.4f); p3d x %.4f (model state %.4f)"
-              % (imu_period, imu[-1].header.frame_id, imu[-1].linear_acceleration.z, accel_z,
-                 yaw_of(sensor[-1].orientation), yaw_of(state.pose.orientation), truth.pose.pose.position.x,
-                 state.pose.position.x))
+        print(f"figure: imu_bot: libgazebo_ros_imu every {imu_period:.3f} s, frame {imu[-1].header.frame_id}, "
+              f"acceleration z {imu[-1].linear_acceleration.z:.3f}; imu sensor acceleration z {accel_z:.3f} m/s^2, yaw "
+              f"{yaw_of(sensor[-1].orientation):.4f} (truth {yaw_of(state.pose.orientation):.4f}); p3d x "
+              f"{truth.pose.pose.position.x:.4f} (model state {state.pose.position.x:.4f})")
         self.assertAlmostEqual(imu_period, 0.01, places=3)
         self.assertEqual(imu[-1].header.frame_id, "base_footprint")  # sdformat renames the lumped imu_link
         self.assertEqual(sensor[-1].header.frame_id, "imu_link")

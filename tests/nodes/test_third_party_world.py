@@ -47,8 +47,8 @@ class ThirdPartyWorld(unittest.TestCase):
         scan = wait_for(lambda: self.latest(self.scan), what="/scan")
         for name, (angle, expected) in (("round pillar", ROUND_PILLAR), ("square pillar", SQUARE_PILLAR)):
             measured = self.range_at(scan, angle)
-            print("figure: minibot lidar, %s at %.0f deg: %.3f m (world: %.2f m)"
-                  % (name, math.degrees(angle), measured, expected))
+            print(f"figure: minibot lidar, {name} at {math.degrees(angle):.0f} deg: {measured:.3f} m "
+                  f"(world: {expected:.2f} m)")
             self.assertAlmostEqual(measured, expected, delta=0.05, msg=name)
         self.assertEqual(self.range_at(scan, math.pi), float("inf"), "nothing behind the robot within 3.5 m")
 

@@ -53,7 +53,7 @@ def course_text(world, model):
     return (world_arg + COURSE_ARGS
             + (("include", "$(find gazebo_ros)/launch/empty_world.launch", world_pass + COURSE_INCLUDE_ARGS),
                ("param", "robot_description", None,
-                "$(find xacro)/xacro --inorder '$(find mbot_description)/urdf/gazebo/%s'" % model))
+                f"$(find xacro)/xacro --inorder '$(find mbot_description)/urdf/gazebo/{model}'"))
             + COURSE_NODES)
 
 
@@ -81,7 +81,7 @@ def _what_matters(element):
     if element.tag == "node":
         return ("node", element.get("name"), element.get("pkg"), element.get("type"), words(element.get("args")),
                 tuple(_what_matters(child) for child in element))
-    raise AssertionError("unexpected <%s> in a course launch file" % element.tag)
+    raise AssertionError(f"unexpected <{element.tag}> in a course launch file")
 
 
 @pytest.mark.parametrize("name", sorted(COURSE_FILES))

@@ -17,22 +17,23 @@ WORKSPACE = os.path.dirname(TESTS)
 def make_package(root, name, depends=(), exports=""):
     folder = root / name
     folder.mkdir(parents=True)
-    (folder / "package.xml").write_text(textwrap.dedent("""\
+    dependencies = "".join(f"<depend>{depend}</depend>" for depend in depends)
+    (folder / "package.xml").write_text(textwrap.dedent(f"""\
         <?xml version="1.0"?>
         <package format="2">
-          <name>%s</name><version>1.0.0</version><description>test</description>
+          <name>{name}</name><version>1.0.0</version><description>test</description>
           <maintainer email="a@b.c">a</maintainer><license>BSD</license>
           <buildtool_depend>catkin</buildtool_depend>
-          %s
-          <export>%s</export>
+          {dependencies}
+          <export>{exports}</export>
         </package>
-        """) % (name, "".join("<depend>%s</depend>" % depend for depend in depends), exports))
+        """))
     return folder
 
 
 def make_model(folder, name):
     (folder / name).mkdir(parents=True)
-    (folder / name / "model.config").write_text("<model><name>%s</name><sdf>model.sdf</sdf></model>" % name)
+    (folder / name / "model.config").write_text(f"<model><name>{name}</name><sdf>model.sdf</sdf></model>")
 
 
 @pytest.fixture

@@ -101,17 +101,17 @@ def main():
     args = parser.parse_args()
 
     raw = raw_pybullet_rtf(args.sim_seconds)
-    print("raw PyBullet real-time factor: %.2f" % raw, flush=True)
+    print(f"raw PyBullet real-time factor: {raw:.2f}", flush=True)
     with PrivateMaster() as master:
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy and the launches
         rospy.init_node("bench_bridge", disable_signals=True)
         bridge, topics = bridge_rtf(args.wall_seconds)
-        print("bridge real-time factor (%d topics subscribed): %.2f" % (topics, bridge))
-        print("bridge / raw: %.2f" % (bridge / raw))
+        print(f"bridge real-time factor ({topics} topics subscribed): {bridge:.2f}")
+        print(f"bridge / raw: {bridge / raw:.2f}")
         # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several.
         launches = sorted(first_odom_seconds() for _ in range(args.launches))
-        print("roslaunch to first /odom: median %.2f s (%d launches, %.2f to %.2f s)"
-              % (statistics.median(launches), len(launches), launches[0], launches[-1]), flush=True)
+        print(f"roslaunch to first /odom: median {statistics.median(launches):.2f} s ({len(launches)} launches, "
+              f"{launches[0]:.2f} to {launches[-1]:.2f} s)", flush=True)
     # The others, each in a process of its own (each starts its own master and rospy node).
     for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_cameras.py"):
         status = subprocess.call([sys.executable, os.path.join(HERE, script)])

@@ -71,8 +71,8 @@ def serialized(message) -> int:
 
 def frame_costs(kinect_urdf: str, width: int, height: int, frames: int):
     """Median ms of: one frame (render, rgb8), the depth image, the point cloud."""
-    urdf = kinect_urdf.replace("<width>640</width>", "<width>%d</width>" % width).replace(
-        "<height>480</height>", "<height>%d</height>" % height)
+    urdf = kinect_urdf.replace("<width>640</width>", f"<width>{width}</width>").replace(
+        "<height>480</height>", f"<height>{height}</height>")
     sim, spawned = spawn(urdf)
     try:
         kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
@@ -162,19 +162,19 @@ def main():
         os.environ[RENDERER_ENV] = renderer
         for width, height in SIZES:
             render, depth, cloud, used = frame_costs(kinect_urdf, width, height, args.frames)
-            print("camera frame %dx%d (%s renderer): %.1f ms render + rgb8, %.1f ms depth image, %.1f ms point "
-                  "cloud" % (width, height, used, render, depth, cloud), flush=True)
+            print(f"camera frame {width}x{height} ({used} renderer): {render:.1f} ms render + rgb8, {depth:.1f} ms "
+                  f"depth image, {cloud:.1f} ms point cloud", flush=True)
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
-        print("real-time factor, course camera robot (1280x720 at 30 Hz, image subscribed, %s): %.2f"
-              % (renderer, median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds)), flush=True)
-        print("real-time factor, course kinect robot (640x480 at 20 Hz, rgb image subscribed, %s): %.2f"
-              % (renderer, median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds)), flush=True)
+        print(f"real-time factor, course camera robot (1280x720 at 30 Hz, image subscribed, {renderer}): "
+              f"{median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds):.2f}", flush=True)
+        print(f"real-time factor, course kinect robot (640x480 at 20 Hz, rgb image subscribed, {renderer}): "
+              f"{median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds):.2f}", flush=True)
     os.environ.pop(RENDERER_ENV)
     without = median_of(args.runs, imu_rtf, mbot_urdf, args.sim_seconds, False)
     with_imu = median_of(args.runs, imu_rtf, mbot_urdf, args.sim_seconds, True)
-    print("real-time factor, mbot without IMU: %.2f; with TurtleBot3's libgazebo_ros_imu.so at updateRate 0 "
-          "(1000 readings a sim second): %.2f" % (without, with_imu), flush=True)
+    print(f"real-time factor, mbot without IMU: {without:.2f}; with TurtleBot3's libgazebo_ros_imu.so at updateRate 0 "
+          f"(1000 readings a sim second): {with_imu:.2f}", flush=True)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 def real_time_factor(ros_control: bool, wall_seconds: float) -> float:
     """Launch one variant against the running master, measure, stop it."""
     launch = subprocess.Popen(["roslaunch", os.path.join(HERE, "mbot_bench.launch"),
-                               "ros_control:=%s" % str(ros_control).lower()],
+                               f"ros_control:={str(ros_control).lower()}"],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     try:
         prefix = "/mobile_base_controller" if ros_control else ""
@@ -60,10 +60,10 @@ def main():
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
         rospy.init_node("bench_ros_control", disable_signals=True)
         plugin = real_time_factor(False, args.wall_seconds)
-        print("plugin-driven mbot real-time factor: %.2f" % plugin, flush=True)
+        print(f"plugin-driven mbot real-time factor: {plugin:.2f}", flush=True)
         controlled = real_time_factor(True, args.wall_seconds)
-        print("ros_control mbot real-time factor: %.2f" % controlled)
-        print("ros_control / plugin: %.2f (target >= 0.8)" % (controlled / plugin))
+        print(f"ros_control mbot real-time factor: {controlled:.2f}")
+        print(f"ros_control / plugin: {controlled / plugin:.2f} (target >= 0.8)")
 
 
 if __name__ == "__main__":

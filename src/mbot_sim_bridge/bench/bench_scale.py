@@ -41,7 +41,7 @@ def raw_robots_rtf(sim_seconds: float) -> float:
     sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), registry)
     for index in range(ROBOTS):  # the places and turn rates of multi_mbot.launch and the bridge run below
         place = pose_from_xyz_rpy((-1.0 + 0.8 * (index % 5), -0.5 + 1.0 * (index // 5), 0), (0, 0, 0))
-        spawned = sim.spawn_robot(parse_robot(urdf), "mbot_%d" % (index + 1), place)
+        spawned = sim.spawn_robot(parse_robot(urdf), f"mbot_{index + 1}", place)
         next(p for p in spawned.plugins if isinstance(p, DiffDrive)).set_command(0.0, turn_rate(index))
     started = time.perf_counter()
     sim.step(int(sim_seconds / sim.step_size))
@@ -60,9 +60,9 @@ def box_world(path: str):
     side = int(BOXES ** 0.5) + 1
     for index in range(BOXES):
         x, y = 0.5 * (index % side), 0.5 * (index // side)
-        rows.append("<model name='box_%d'><static>true</static><pose>%g %g 0.1 0 0 0</pose><link name='l'>"
-                    "<collision name='c'><geometry><box><size>0.2 0.2 0.2</size></box></geometry></collision>"
-                    "</link></model>" % (index, x, y))
+        rows.append(f"<model name='box_{index}'><static>true</static><pose>{x:g} {y:g} 0.1 0 0 0</pose><link "
+                    "name='l'><collision name='c'><geometry><box><size>0.2 0.2 "
+                    "0.2</size></box></geometry></collision></link></model>")
     rows.append("</world></sdf>")
     with open(path, "w") as stream:
         stream.write("\n".join(rows))
@@ -89,7 +89,7 @@ def bridge_rtf(command, ready_topics, wall_seconds: float, commands=None) -> flo
         deadline = time.monotonic() + 300
         while not set(ready_topics) <= {topic for topic, _ in rospy.get_published_topics()}:
             if time.monotonic() > deadline or launch.poll() is not None:
-                raise RuntimeError("%s did not come up" % " ".join(command))
+                raise RuntimeError(f"{' '.join(command)} did not come up")
             time.sleep(0.2)
         publishers = [rospy.Publisher(topic, message.__class__, queue_size=1, latch=True)
                       for topic, message in (commands or {}).items()]
@@ -121,7 +121,7 @@ def main():
     args = parser.parse_args()
 
     def report(what, raw, bridge):
-        print("%s: raw PyBullet %.2f, bridge %.2f, bridge / raw %.2f" % (what, raw, bridge, bridge / raw), flush=True)
+        print(f"{what}: raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}", flush=True)
 
     # The raw runs go first: once rospy is up, the plugins' rosDebugLevel Debug would print every tag read.
     raw_robots = raw_robots_rtf(args.sim_seconds)
@@ -136,14 +136,14 @@ def main():
             for index in range(ROBOTS):
                 twist = Twist()
                 twist.angular.z = turn_rate(index)
-                commands["/mbot_%d/cmd_vel" % (index + 1)] = twist
-            bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", "count:=%d" % ROBOTS,
+                commands[f"/mbot_{index + 1}/cmd_vel"] = twist
+            bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", f"count:={ROBOTS}",
                                  "gui:=false", "real_time_factor:=0"],
-                                ["/mbot_%d/odom" % n for n in range(1, ROBOTS + 1)], args.wall_seconds, commands)
-            report("%d lidar mbots, real-time factor" % ROBOTS, raw_robots, bridge)
+                                [f"/mbot_{n}/odom" for n in range(1, ROBOTS + 1)], args.wall_seconds, commands)
+            report(f"{ROBOTS} lidar mbots, real-time factor", raw_robots, bridge)
             bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
                                  "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
-            report("%d static boxes, real-time factor" % BOXES, raw_boxes, bridge)
+            report(f"{BOXES} static boxes, real-time factor", raw_boxes, bridge)
 
 
 if __name__ == "__main__":

@@ -29,18 +29,18 @@ def list_controllers():
         print("No controllers are loaded in mechanism control")
     for state in controllers:
         interfaces = sorted(set(resource.hardware_interface for resource in state.claimed_resources))
-        print("'%s' - '%s' ( %s )" % (state.name, "+".join(interfaces), state.state))
+        print(f"'{state.name}' - '{'+'.join(interfaces)}' ( {state.state} )")
 
 
 def load_controller(name):
     ok = _service("load_controller", LoadController)(LoadControllerRequest(name)).ok
-    print(("Loaded '%s'" if ok else "Error when loading '%s'") % name)
+    print(f"Loaded '{name}'" if ok else f"Error when loading '{name}'")
     return ok
 
 
 def unload_controller(name):
     ok = _service("unload_controller", UnloadController)(UnloadControllerRequest(name)).ok
-    print(("Unloaded '%s' successfully" if ok else "Error when unloading '%s'") % name)
+    print(f"Unloaded '{name}' successfully" if ok else f"Error when unloading '{name}'")
     return ok
 
 
@@ -50,11 +50,11 @@ def start_stop_controllers(start_controllers=(), stop_controllers=()):
     ok = _service("switch_controller", SwitchController)(request).ok
     if ok:
         if start_controllers:
-            print("Started {} successfully".format(list(start_controllers)))
+            print(f"Started {list(start_controllers)} successfully")
         if stop_controllers:
-            print("Stopped {} successfully".format(list(stop_controllers)))
+            print(f"Stopped {list(stop_controllers)} successfully")
     else:
-        print("Error when starting {} and stopping {}".format(list(start_controllers), list(stop_controllers)))
+        print(f"Error when starting {list(start_controllers)} and stopping {list(stop_controllers)}")
     return ok
 
 

@@ -81,8 +81,8 @@ class Spawner:
                 return False
             if not heard and not warned and self.timeout is not None and time.monotonic() - started > self.timeout:
                 warned = True
-                rospy.logwarn('Controller Spawner hasn\'t heard anything from its "wait for" topic (%s)'
-                              % self.args.wait_for)
+                rospy.logwarn('Controller Spawner hasn\'t heard anything from its "wait for" '
+                              f'topic ({self.args.wait_for})')
         subscriber.unregister()
         return True
 
@@ -110,16 +110,16 @@ class Spawner:
             if load(name).ok:
                 self.loaded.append(name)
             else:
-                rospy.logerr("Failed to load %s" % name)
-        rospy.loginfo("Controller Spawner: Loaded controllers: %s" % ", ".join(self.loaded))
+                rospy.logerr(f"Failed to load {name}")
+        rospy.loginfo(f"Controller Spawner: Loaded controllers: {', '.join(self.loaded)}")
         if self.stop.is_set():
             return 0
         if not self.args.stopped and self.loaded:
             switch = rospy.ServiceProxy(self.services["switch_controller"], SwitchController)
             if switch(self.loaded, [], SwitchControllerRequest.STRICT, False, 0.0).ok:
-                rospy.loginfo("Started controllers: %s" % ", ".join(self.loaded))
+                rospy.loginfo(f"Started controllers: {', '.join(self.loaded)}")
             else:
-                rospy.logerr("Failed to start controllers: %s" % ", ".join(self.loaded))
+                rospy.logerr(f"Failed to start controllers: {', '.join(self.loaded)}")
         self.stop.wait()
         return 0
 
@@ -135,11 +135,11 @@ class Spawner:
             rospy.loginfo("Unloading all loaded controllers...")
             unload = rospy.ServiceProxy(self.services["unload_controller"], UnloadController)
             for name in reversed(self.loaded):
-                rospy.loginfo("Trying to unload %s" % name)
+                rospy.loginfo(f"Trying to unload {name}")
                 unload(name)
-                rospy.loginfo("Succeeded in unloading %s" % name)
+                rospy.loginfo(f"Succeeded in unloading {name}")
         except (rospy.ServiceException, rospy.ROSException) as error:
-            rospy.logwarn("Controller Spawner error while taking down controllers: %s" % error)
+            rospy.logwarn(f"Controller Spawner error while taking down controllers: {error}")
 
 
 def main():

@@ -31,7 +31,7 @@ def main():
         running = {state.name for state in list_controllers().controller if state.state == "running"}
         to_stop = wanted & running
         if to_stop:
-            rospy.loginfo("Inhibiting controllers: %s" % ", ".join(sorted(to_stop)))
+            rospy.loginfo(f"Inhibiting controllers: {', '.join(sorted(to_stop))}")
             switch(strictness=SwitchControllerRequest.BEST_EFFORT, stop_controllers=sorted(to_stop))
             inhibited.update(to_stop)
         stop.wait(3.0)

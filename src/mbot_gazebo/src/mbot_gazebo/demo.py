@@ -113,8 +113,8 @@ class Tour:
             return
         self.last_progress = now
         pose = self.recorder.pose()
-        line = "  sim %6.1f s | %5.2f m driven | %4d scans" % (
-            pose[0] if pose else 0.0, self.recorder.distance(), self.recorder.scans)
+        sim_time = pose[0] if pose else 0.0
+        line = f"  sim {sim_time:6.1f} s | {self.recorder.distance():5.2f} m driven | {self.recorder.scans:4d} scans"
         # On a terminal one line updates in place; in a log, a line every few seconds.
         if self.on_terminal:
             print("\r" + line, end="\n" if final else "", file=sys.stderr, flush=True)
@@ -129,8 +129,7 @@ class Tour:
             if done(pose):
                 return
             if pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
-                raise RuntimeError("the robot did not finish '%s' (stuck at x %.2f, y %.2f)"
-                                   % (what, pose[1], pose[2]))
+                raise RuntimeError(f"the robot did not finish '{what}' (stuck at x {pose[1]:.2f}, y {pose[2]:.2f})")
             self.progress()
             time.sleep(0.005)
 
@@ -143,7 +142,7 @@ class Tour:
                     # Hold the heading the last turn ended on, so the legs come out straight.
                     self.command(LINEAR_SPEED, HEADING_GAIN * math.remainder(heading - pose[3], 2 * math.pi))
                     return math.hypot(pose[1] - x0, pose[2] - y0) >= amount
-                self.wait(forward, "forward %.1f m" % amount)
+                self.wait(forward, f"forward {amount:.1f} m")
             else:
                 heading += math.radians(amount)
                 linear = LINEAR_SPEED / 3 if kind == "arc" else 0.0
@@ -153,7 +152,7 @@ class Tour:
                     remaining = math.remainder(heading - pose[3], 2 * math.pi)
                     self.command(linear, max(MIN_TURN_SPEED, min(TURN_SPEED, HEADING_GAIN * remaining)))
                     return remaining < math.radians(1.0)
-                self.wait(turn, "%s %d degrees" % (kind, amount))
+                self.wait(turn, f"{kind} {int(amount)} degrees")
         self.command(0.0, 0.0)
         self.progress(final=True)
 
@@ -177,11 +176,11 @@ def main(argv=None):
         with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
             simulation = subprocess.Popen(
                 ["roslaunch", "mbot_gazebo", "mbot_world.launch", "world_name:=" + world_path,
-                 "model:=" + model, "gui:=%s" % str(args.gui).lower(), "real_time_factor:=0"],
+                 "model:=" + model, f"gui:={str(args.gui).lower()}", "real_time_factor:=0"],
                 env=os.environ, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            print("mbot demo: %s world, lidar mbot, as fast as the machine goes (log: %s)"
-                  % (args.world, os.path.relpath(log_dir)), file=sys.stderr, flush=True)
+            print(f"mbot demo: {args.world} world, lidar mbot, as fast as the machine goes (log: "
+                  f"{os.path.relpath(log_dir)})", file=sys.stderr, flush=True)
             return tour_and_draw(args, world_path, started)
         finally:
             stop_process_group(simulation)
@@ -226,29 +225,29 @@ def tour_and_draw(args, world_path, started):
     try:
         tour.run()
     except RuntimeError as error:
-        print("\nmbot demo: %s" % error, file=sys.stderr)
+        print(f"\nmbot demo: {error}", file=sys.stderr)
         return 1
     sim_seconds, wall_seconds = recorder.pose()[0] - sim_start, time.monotonic() - wall_start
     with recorder.lock:
         path, headings, points = list(recorder.path), list(recorder.headings), list(recorder.scan_points)
         scans = recorder.scans
     _, x, y, yaw = recorder.pose()
-    summary = ["distance driven: %.2f m" % recorder.distance(),
-               "tour: %.1f s of sim time in %.1f s of wall time (real-time factor %.1f)"
-               % (sim_seconds, wall_seconds, sim_seconds / wall_seconds),
-               "scans received: %d (%d points)" % (scans, len(points)),
-               "final odometry: x %.3f m, y %.3f m, yaw %.1f deg" % (x, y, math.degrees(yaw))]
+    summary = [f"distance driven: {recorder.distance():.2f} m",
+               f"tour: {sim_seconds:.1f} s of sim time in {wall_seconds:.1f} s of wall time (real-time factor "
+               f"{sim_seconds / wall_seconds:.1f})",
+               f"scans received: {scans} ({len(points)} points)",
+               f"final odometry: x {x:.3f} m, y {y:.3f} m, yaw {math.degrees(yaw):.1f} deg"]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     camera = camera_frame(world_path, x, y, yaw)
     frame = draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
-                      title="mbot demo: %s" % args.world, summary_lines=summary, headings=numpy.array(headings),
+                      title=f"mbot demo: {args.world}", summary_lines=summary, headings=numpy.array(headings),
                       camera_image=camera, camera_caption="the course's kinect at the end pose (640x480)")
     # Beside the picture: the recorded odometry and where the plot sits in the PNG, so the two can be compared.
     stem = os.path.splitext(args.out)[0]
     numpy.savetxt(stem + "_odometry.csv", numpy.column_stack([path, headings]), delimiter=",",
                   header="x_m,y_m,yaw_rad", comments="")
     frame.save(stem + "_frame.json")
-    for line in summary + ["picture: %s" % os.path.relpath(args.out), "total wall time: %.1f s"
-                           % (time.monotonic() - started)]:
+    for line in summary + [f"picture: {os.path.relpath(args.out)}",
+                           f"total wall time: {time.monotonic() - started:.1f} s"]:
         print(line)
     return 0

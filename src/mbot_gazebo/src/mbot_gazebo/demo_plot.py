@@ -111,7 +111,7 @@ def draw_demo(world, path_xy, scan_points_xy, out_path: str, title: str = "", su
                              label="obstacles (SDF collisions)"))
     if len(scan):
         handles.append(axes.scatter(scan[:, 0], scan[:, 1], s=8, color=SCAN_COLOUR, linewidths=0, zorder=2,
-                                    label="lidar hits (%d)" % len(scan)))
+                                    label=f"lidar hits ({len(scan)})"))
     xlim, ylim = _fit_box(*_frame_limits(path, scan, obstacles), box_px)
     if len(path):
         handles += axes.plot(path[:, 0], path[:, 1], color=PATH_COLOUR, linewidth=2.5, solid_capstyle="round",

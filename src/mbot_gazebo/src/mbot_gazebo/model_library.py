@@ -50,7 +50,7 @@ def _read_manifest(name: str, directory: str, manifest: str) -> LibraryModel:
     try:
         root = ET.parse(manifest).getroot()
     except ET.ParseError as error:
-        return LibraryModel(name, name, "(unreadable %s: %s)" % (os.path.basename(manifest), error), directory)
+        return LibraryModel(name, name, f"(unreadable {os.path.basename(manifest)}: {error})", directory)
     title = " ".join((root.findtext("name") or name).split())
     description = " ".join((root.findtext("description") or "").split())
     return LibraryModel(name, title, description, directory)
@@ -63,8 +63,8 @@ def find_model(name: str, models: Sequence[LibraryModel]) -> LibraryModel:
             return model
     names = [model.name for model in models]
     nearest = difflib.get_close_matches(name, names, n=5, cutoff=0.5)
-    hint = ("; nearest: %s" % ", ".join(nearest)) if nearest else ""
-    raise UnknownModel("no model '%s' on the model path%s (./mbot models lists all %d)" % (name, hint, len(names)))
+    hint = f"; nearest: {', '.join(nearest)}" if nearest else ""
+    raise UnknownModel(f"no model '{name}' on the model path{hint} (./mbot models lists all {len(names)})")
 
 
 def instance_name(name: str, existing: Sequence[str]) -> str:
@@ -72,9 +72,9 @@ def instance_name(name: str, existing: Sequence[str]) -> str:
     if name not in existing:
         return name
     index = 0
-    while "%s_%d" % (name, index) in existing:
+    while f"{name}_{index}" in existing:
         index += 1
-    return "%s_%d" % (name, index)
+    return f"{name}_{index}"
 
 
 def format_table(models: Sequence[LibraryModel]) -> str:
@@ -82,6 +82,6 @@ def format_table(models: Sequence[LibraryModel]) -> str:
     width = max((len(model.name) for model in models), default=0)
     lines = []
     for model in models:
-        lines.append("%-*s  %s" % (width, model.name, model.description or model.title))
-        lines.append("%-*s  %s" % (width, "", model.path))
+        lines.append(f"{model.name:<{width}}  {model.description or model.title}")
+        lines.append(f"{'':<{width}}  {model.path}")
     return "\n".join(lines)

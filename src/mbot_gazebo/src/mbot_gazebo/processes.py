@@ -32,7 +32,7 @@ class PrivateMaster:
     (this process's environment with ROS_MASTER_URI pointing at it) for the commands to run against it."""
 
     def __init__(self, timeout: float = 30.0):
-        self.uri = "http://127.0.0.1:%d" % free_port()
+        self.uri = f"http://127.0.0.1:{free_port()}"
         self.environment = dict(os.environ, ROS_MASTER_URI=self.uri)
         self.timeout = timeout
         self._process = None
@@ -45,7 +45,7 @@ class PrivateMaster:
         while not rosgraph.is_master_online(master_uri=self.uri):
             if time.monotonic() > deadline or self._process.poll() is not None:
                 self.__exit__()
-                raise RuntimeError("no ROS master came up at %s within %.0f s" % (self.uri, self.timeout))
+                raise RuntimeError(f"no ROS master came up at {self.uri} within {self.timeout:.0f} s")
             time.sleep(0.05)
         return self
 

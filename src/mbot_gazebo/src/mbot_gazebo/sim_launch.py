@@ -41,7 +41,7 @@ def main(argv=None):
     try:
         path = roslaunch.rlutil.resolve_launch_arguments([package, launch_file])[0]
     except roslaunch.RLException as error:
-        print("mbot sim: %s" % error, file=sys.stderr)
+        print(f"mbot sim: {error}", file=sys.stderr)
         return 1
     run_id = roslaunch.rlutil.get_or_generate_uuid(None, False)
     roslaunch.configure_logging(run_id)
@@ -60,12 +60,12 @@ def main(argv=None):
             parent.spin_once()
             time.sleep(0.1)
     except roslaunch.RLException as error:
-        print("mbot sim: %s" % error, file=sys.stderr)
+        print(f"mbot sim: {error}", file=sys.stderr)
         return 1
     finally:
         parent.shutdown()
     if watch.died.is_set() and not stop.is_set():
-        print("mbot sim: the simulator stopped (exit status %s); the launch is shut down" % watch.exit_code,
+        print(f"mbot sim: the simulator stopped (exit status {watch.exit_code}); the launch is shut down",
               file=sys.stderr)
         return watch.exit_code if watch.exit_code else 1
     return 0

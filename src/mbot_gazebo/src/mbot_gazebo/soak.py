@@ -76,7 +76,7 @@ class Watcher:
 
     def _stamp(self, message, key, stamp):
         # Per publisher: two nodes on one topic (the bridge and joint_state_publisher) keep clocks of their own.
-        key = "%s from %s" % (key, message._connection_header["callerid"])
+        key = f"{key} from {message._connection_header['callerid']}"
         seconds = stamp.to_sec()
         if key in self._last and seconds < self._last[key]:
             self.backwards[key] = self.backwards.get(key, 0) + 1
@@ -180,7 +180,7 @@ def _memory_megabytes(pid: int):
     """(RSS, its anonymous part) in MB. A leak grows the anonymous part; the file-backed rest (libraries)
     shrinks and grows again as the kernel reclaims pages under other processes' memory pressure."""
     values = {}
-    with open("/proc/%d/status" % pid) as status:
+    with open(f"/proc/{pid}/status") as status:
         for line in status:
             key, _, value = line.partition(":")
             if key in ("VmRSS", "RssAnon"):
@@ -192,7 +192,7 @@ def _bridge_pid() -> int:
     uri = rosnode.get_api_uri(rosgraph.Master("/mbot_soak"), "/gazebo")
     code, message, pid = xmlrpc.client.ServerProxy(uri).getPid("/mbot_soak")
     if code != 1:
-        raise RuntimeError("the bridge did not give its pid: %s" % message)
+        raise RuntimeError(f"the bridge did not give its pid: {message}")
     return pid
 
 
@@ -202,7 +202,7 @@ def _pose(response) -> Pose:
 
 
 def _overlap_text(depth: float, name: str) -> str:
-    return "none" if math.isinf(depth) else "%.4f m (%s)" % (depth, name)
+    return "none" if math.isinf(depth) else f"{depth:.4f} m ({name})"
 
 
 def soak(seconds: float, world_path: str, seed: int, launch_log) -> int:
@@ -217,7 +217,7 @@ def soak(seconds: float, world_path: str, seed: int, launch_log) -> int:
         except (rospy.ROSException, rospy.ServiceException):
             pass
         if time.monotonic() > deadline:
-            print("mbot soak: the mbot did not appear within %.0f s (see %s)" % (START_TIMEOUT, launch_log),
+            print(f"mbot soak: the mbot did not appear within {START_TIMEOUT:.0f} s (see {launch_log})",
                   file=sys.stderr)
             return 1
         time.sleep(0.1)
@@ -247,12 +247,12 @@ def soak(seconds: float, world_path: str, seed: int, launch_log) -> int:
             poses = {ROBOT: _pose(get_state(ROBOT, ""))}
             poses.update((name, _pose(get_state(name, ""))) for name in probe.movable)
         except rospy.ServiceException as error:
-            failures.append("get_model_state failed: %s" % error)
+            failures.append(f"get_model_state failed: {error}")
             break
         depth = probe.measure(poses)
         samples += 1
         if depth < -TUNNEL_DEPTH or poses[ROBOT].position[2] < -TUNNEL_DEPTH:
-            failures.append("the robot tunnelled: overlap %.3f m at %s" % (depth, poses[ROBOT].position))
+            failures.append(f"the robot tunnelled: overlap {depth:.3f} m at {poses[ROBOT].position}")
             finished = True
         if baseline_anonymous is None and now - start >= min(WARM_UP_SECONDS, seconds / 2):
             baseline_anonymous = _memory_megabytes(pid)[1]
@@ -262,10 +262,10 @@ def soak(seconds: float, world_path: str, seed: int, launch_log) -> int:
             with watcher.lock:
                 sim_now = watcher.sim_time or 0.0
             rtf = (sim_now - (minute_sim if minute_sim is not None else 0.0)) / max(now - minute_start, 1e-9)
-            print("soak: %5.1f min | RSS %.1f MB (anonymous %.1f MB) | RTF %.2f | sim %.0f s | NaN %d | "
-                  "backwards stamps %d | deepest overlap %s | %d messages, %d overlap samples"
-                  % ((now - start) / 60.0, rss, anonymous, rtf, sim_now, nan, backwards,
-                     _overlap_text(*probe.deepest), watcher.messages, samples), flush=True)
+            print(f"soak: {(now - start) / 60.0:5.1f} min | RSS {rss:.1f} MB (anonymous {anonymous:.1f} MB) | RTF "
+                  f"{rtf:.2f} | sim {sim_now:.0f} s | NaN {nan} | backwards stamps {backwards} | deepest overlap "
+                  f"{_overlap_text(*probe.deepest)} | {watcher.messages} messages, {samples} "
+                  "overlap samples", flush=True)
             minute_start, minute_sim, next_report = now, sim_now, now + 60.0
         if finished:
             break
@@ -278,22 +278,21 @@ def soak(seconds: float, world_path: str, seed: int, launch_log) -> int:
     growth = (final_anonymous - baseline_anonymous) / baseline_anonymous if baseline_anonymous else 0.0
     with watcher.lock:
         sim_now = watcher.sim_time or 0.0
-    print("figure: soak %.1f min: sim %.0f s (mean RTF %.2f), RSS %.1f MB, anonymous %.1f MB after warm-up -> "
-          "%.1f MB (%+.1f %%), NaN %d, backwards stamps %d, deepest overlap %s, %d messages checked"
-          % (total_wall / 60.0, sim_now, sim_now / total_wall, final_rss, baseline_anonymous or final_anonymous,
-             final_anonymous, 100 * growth, nan, backwards, _overlap_text(*probe.deepest), watcher.messages),
-          flush=True)
+    print(f"figure: soak {total_wall / 60.0:.1f} min: sim {sim_now:.0f} s (mean RTF {sim_now / total_wall:.2f}), RSS "
+          f"{final_rss:.1f} MB, anonymous {baseline_anonymous or final_anonymous:.1f} MB after warm-up -> "
+          f"{final_anonymous:.1f} MB ({100 * growth:+.1f} %), NaN {nan}, backwards stamps {backwards}, deepest overlap "
+          f"{_overlap_text(*probe.deepest)}, {watcher.messages} messages checked", flush=True)
     if watcher.messages == 0 or sim_now <= 0.0:
         failures.append("nothing arrived from the simulation")
     if nan:
-        failures.append("NaN in %s" % nan_by_topic)
+        failures.append(f"NaN in {nan_by_topic}")
     if backwards:
-        failures.append("stamps went backwards: %s" % backwards_by_key)
+        failures.append(f"stamps went backwards: {backwards_by_key}")
     if growth > MEMORY_GROWTH_LIMIT:
-        failures.append("the bridge's anonymous memory grew %.1f %% after the warm-up (limit %.0f %%)"
-                        % (100 * growth, 100 * MEMORY_GROWTH_LIMIT))
+        failures.append(f"the bridge's anonymous memory grew {100 * growth:.1f} % after the warm-up (limit "
+                        f"{100 * MEMORY_GROWTH_LIMIT:.0f} %)")
     for failure in failures:
-        print("mbot soak: FAILED: %s" % failure, file=sys.stderr)
+        print(f"mbot soak: FAILED: {failure}", file=sys.stderr)
     return 1 if failures else 0
 
 
@@ -314,13 +313,13 @@ def main(argv=None):
                 ["roslaunch", "mbot_gazebo", "mbot_play_ground.launch", "gui:=false",
                  "real_time_factor:=0"],
                 env=os.environ, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-        print("mbot soak: %.1f min, lidar mbot in the play ground at real-time factor 0, random commands "
-              "(seed %d; log: %s)" % (args.minutes, args.seed, launch_log), file=sys.stderr, flush=True)
+        print(f"mbot soak: {args.minutes:.1f} min, lidar mbot in the play ground at real-time factor 0, random "
+              f"commands (seed {args.seed}; log: {launch_log})", file=sys.stderr, flush=True)
         try:
             status = soak(args.minutes * 60.0, world_path, args.seed, launch_log)
             if simulation.poll() is not None:
-                print("mbot soak: FAILED: the simulation stopped (status %s; see %s)"
-                      % (simulation.returncode, launch_log), file=sys.stderr)
+                print(f"mbot soak: FAILED: the simulation stopped (status {simulation.returncode}; see {launch_log})",
+                      file=sys.stderr)
                 status = 1
             return status
         finally:

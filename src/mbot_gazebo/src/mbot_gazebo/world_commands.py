@@ -33,7 +33,7 @@ def parse_arguments(argv):
     for command, default in ((insert, 0.0), (move, None)):
         for axis in ("x", "y", "z", "Y"):
             command.add_argument("-" + axis, type=float, default=default,
-                                 help="%s (%s)" % ("yaw" if axis == "Y" else axis, "rad" if axis == "Y" else "m"))
+                                 help=f"{'yaw' if axis == 'Y' else axis} ({'rad' if axis == 'Y' else 'm'})")
     insert.add_argument("--as", dest="instance", metavar="INSTANCE",
                         help="name in the simulator (default: NAME, then NAME_0, NAME_1... as Gazebo names them)")
     delete = commands.add_parser("delete", help="delete model INSTANCE")
@@ -49,7 +49,7 @@ def _proxy(name, service_type):
     try:
         rospy.wait_for_service(name, timeout=SERVICE_TIMEOUT)
     except rospy.ROSException:
-        raise CommandError("no simulator answers on %s (start one with ./mbot sim WORLD)" % name) from None
+        raise CommandError(f"no simulator answers on {name} (start one with ./mbot sim WORLD)") from None
     return rospy.ServiceProxy(name, service_type)
 
 
@@ -69,15 +69,15 @@ def insert(arguments):
         spawn_model.spawn(spawn_arguments)
     except spawn_model.SpawnError as error:
         raise CommandError(str(error)) from None
-    print("inserted %s as '%s' at x %g y %g z %g yaw %g"
-          % (model.name, instance, arguments.x, arguments.y, arguments.z, arguments.Y))
+    print(f"inserted {model.name} as '{instance}' at x {arguments.x:g} y {arguments.y:g} z "
+          f"{arguments.z:g} yaw {arguments.Y:g}")
 
 
 def move(arguments):
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rpy  # here: PyBullet's import prints
     current = _proxy("/gazebo/get_model_state", GetModelState)(arguments.instance, "")
     if not current.success:
-        raise CommandError("cannot move '%s': %s" % (arguments.instance, current.status_message))
+        raise CommandError(f"cannot move '{arguments.instance}': {current.status_message}")
     position = current.pose.position
     q = current.pose.orientation
     roll, pitch, yaw = rpy((q.x, q.y, q.z, q.w))
@@ -90,21 +90,22 @@ def move(arguments):
      state.pose.orientation.w) = pose.orientation
     result = _proxy("/gazebo/set_model_state", SetModelState)(state)
     if not result.success:
-        raise CommandError("cannot move '%s': %s" % (arguments.instance, result.status_message))
-    print("moved '%s' to x %g y %g z %g yaw %g" % (arguments.instance, *xyz, rpy(pose.orientation)[2]))
+        raise CommandError(f"cannot move '{arguments.instance}': {result.status_message}")
+    x, y, z = xyz
+    print(f"moved '{arguments.instance}' to x {x:g} y {y:g} z {z:g} yaw {rpy(pose.orientation)[2]:g}")
 
 
 def delete(arguments):
     result = _proxy("/gazebo/delete_model", DeleteModel)(arguments.instance)
     if not result.success:
-        raise CommandError("cannot delete '%s': %s" % (arguments.instance, result.status_message))
-    print("deleted '%s'" % arguments.instance)
+        raise CommandError(f"cannot delete '{arguments.instance}': {result.status_message}")
+    print(f"deleted '{arguments.instance}'")
 
 
 def save_world(arguments):
     result = _proxy("/gazebo/save_world", SaveWorld)(os.path.abspath(arguments.path), arguments.with_robots)
     if not result.success:
-        raise CommandError("save-world failed: %s" % result.status_message)
+        raise CommandError(f"save-world failed: {result.status_message}")
     print(result.status_message)
 
 
@@ -120,5 +121,5 @@ def main(argv=None):
         rospy.init_node("mbot_world", anonymous=True, disable_signals=True)
         COMMANDS[arguments.command](arguments)
     except (CommandError, UnknownModel, rospy.ServiceException, rospy.ROSException) as error:
-        print("mbot_world: %s" % error, file=sys.stderr)
+        print(f"mbot_world: {error}", file=sys.stderr)
         sys.exit(1)

@@ -19,7 +19,7 @@ def test_the_kinect_frame_sees_the_barrier_ahead():
     assert image.shape == (480, 640, 3) and image.dtype == np.uint8
     sky = np.all(image == (178, 178, 178), axis=2)
     colours = len(np.unique(image.reshape(-1, 3), axis=0))
-    print("figure: demo camera frame: %.0f %% sky, %d distinct colours" % (100 * sky.mean(), colours))
+    print(f"figure: demo camera frame: {100 * sky.mean():.0f} % sky, {colours} distinct colours")
     assert 0.2 < sky[:240].mean() < 1.0  # sky above the horizon, with the barrier in it
     assert not sky[300:].any()  # the ground below
 

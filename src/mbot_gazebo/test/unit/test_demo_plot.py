@@ -79,7 +79,7 @@ def test_path_colour_lies_under_every_path_point(drawing, run):
                        np.linalg.norm(pixels - pixels[-1], axis=1)) > MARKER_CLEARANCE
     assert clear.sum() > 150
     found = matches(pixels_at(image, frame, path[clear]), PATH_COLOUR)
-    assert found.all(), "path colour missing at %s" % path[clear][~found][:5]
+    assert found.all(), f"path colour missing at {path[clear][~found][:5]}"
     # The line is 3.5 pixels wide and nowhere steeper than 32 degrees: 5 rows below it is off it.
     columns, rows = np.floor(frame.to_pixels(path[clear])).astype(int).T
     assert not matches(image[rows + 5, columns], PATH_COLOUR).any()
@@ -89,7 +89,7 @@ def test_scan_points_are_drawn_where_they_are(drawing, scan_points):
     _, frame, image = drawing
     assert len(scan_points) > 100
     found = matches(pixels_at(image, frame, scan_points), SCAN_COLOUR)
-    assert found.all(), "scan colour missing at %s" % scan_points[~found][:5]
+    assert found.all(), f"scan colour missing at {scan_points[~found][:5]}"
 
 
 def test_obstacle_is_filled_at_its_centre(drawing, world):

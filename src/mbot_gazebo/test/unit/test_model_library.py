@@ -23,11 +23,11 @@ def write_model(directory, name, description="A test model.", title=None):
     model = directory / name
     model.mkdir(parents=True)
     (model / "model.config").write_text(
-        "<model><name>%s</name><sdf version='1.6'>model.sdf</sdf><description>%s</description></model>"
-        % (title or name, description))
+        f"<model><name>{title or name}</name><sdf "
+        f"version='1.6'>model.sdf</sdf><description>{description}</description></model>")
     (model / "model.sdf").write_text(
-        "<sdf version='1.6'><model name='%s'><static>true</static><link name='l'><collision name='c'><geometry>"
-        "<box><size>1 1 1</size></box></geometry></collision></link></model></sdf>" % name)
+        f"<sdf version='1.6'><model name='{name}'><static>true</static><link name='l'><collision "
+        "name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link></model></sdf>")
     return model
 
 
@@ -54,7 +54,7 @@ def test_look_alikes_say_so_and_load(name, tmp_path):
     assert "built here from" in model.description
     assert model.path == os.path.join(WORKSPACE_MODELS, name)
     # Inserted as spawn_model -database does it: an include in a one-model world.
-    xml = "<sdf version='1.6'><world name='w'><include><uri>model://%s</uri></include></world></sdf>" % name
+    xml = f"<sdf version='1.6'><world name='w'><include><uri>model://{name}</uri></include></world></sdf>"
     world = tmp_path / "spawn.world"
     world.write_text(spawn_world_xml(xml, name, IDENTITY))
     (description,) = parse_world(str(world), [WORKSPACE_MODELS]).models

@@ -61,22 +61,22 @@ def bridge_arguments(prog: str, argv, gui: bool = None):
     remappings = [argument for argument in argv[1:] if ":=" in argument]
     options = _parser(prog).parse_args(rospy.myargv(argv)[1:])
     if options.play:
-        raise CommandLineError("-p/--play %s: the bridge does not play Gazebo logs" % options.play)
+        raise CommandLineError(f"-p/--play {options.play}: the bridge does not play Gazebo logs")
     if options.iters is not None:
-        raise CommandLineError("--iters %d: the bridge runs until stopped (use rosservice call "
-                               "/gazebo/pause_physics to stop the physics)" % options.iters)
+        raise CommandLineError(f"--iters {options.iters}: the bridge runs until stopped (use rosservice call "
+                               "/gazebo/pause_physics to stop the physics)")
     for plugin in options.server_plugin:
         if os.path.basename(plugin) not in BUILT_IN_SYSTEM_PLUGINS:
-            _note(prog, "system plugin %s is not emulated; ignored" % plugin)
+            _note(prog, f"system plugin {plugin} is not emulated; ignored")
     for plugin in options.gui_plugin:
-        _note(prog, "GUI plugin %s is not emulated; ignored" % plugin)
+        _note(prog, f"GUI plugin {plugin} is not emulated; ignored")
     if options.record or options.record_path or options.record_period or options.record_filter \
             or options.record_encoding:
         _note(prog, "recording (-r, --record_*) is not supported; running without recording")
     if options.profile:
-        _note(prog, "physics profile %s is not supported; the world's <physics> is used" % options.profile)
+        _note(prog, f"physics profile {options.profile} is not supported; the world's <physics> is used")
     if options.physics != "ode":
-        _note(prog, "-e %s: the bridge's engine is always Bullet" % options.physics)
+        _note(prog, f"-e {options.physics}: the bridge's engine is always Bullet")
     # An absolute path goes to the bridge as it is: a missing or bad file is the bridge's one fatal line. Only a
     # relative one needs the resource path (a rospack run, which can take a while when its cache is cold).
     world = options.world
@@ -84,8 +84,8 @@ def bridge_arguments(prog: str, argv, gui: bool = None):
         search_path = default_resource_path()
         world = find_world_file(options.world, search_path)
         if world is None:
-            raise CommandLineError("world file %s not found here nor on the resource path %s"
-                                   % (options.world, ":".join(search_path)))
+            raise CommandLineError(f"world file {options.world} not found here nor on the resource "
+                                   f"path {':'.join(search_path)}")
     # Private params set on the command line override the launch file's and any left on the master by an
     # earlier run; values are JSON, which rospy reads as YAML.
     params = {"world_name": world, "paused": options.pause}
@@ -93,19 +93,19 @@ def bridge_arguments(prog: str, argv, gui: bool = None):
         params["seed"] = options.seed
     if gui is not None:
         params["gui"] = gui
-    arguments = [argv[0]] + remappings + ["_%s:=%s" % (name, json.dumps(value)) for name, value in params.items()]
+    arguments = [argv[0]] + remappings + [f"_{name}:={json.dumps(value)}" for name, value in params.items()]
     return arguments + (["--verbose"] if options.verbose else [])
 
 
 def _note(prog: str, message: str):
-    print("%s: %s" % (prog, message), file=sys.stderr, flush=True)
+    print(f"{prog}: {message}", file=sys.stderr, flush=True)
 
 
 def _run(prog: str, runner, gui: bool = None):
     try:
         sys.argv = bridge_arguments(prog, sys.argv, gui)
     except CommandLineError as error:
-        print("%s: %s" % (prog, error), file=sys.stderr)
+        print(f"{prog}: {error}", file=sys.stderr)
         sys.exit(1)
     # Imported here, so that a refused command line and gzclient answer without loading PyBullet.
     from .node import main
@@ -136,7 +136,7 @@ def perf():
             profiler.runcall(main)
         finally:
             profiler.dump_stats(path)
-            _note("perf", "profile written to %s (read it with: python3 -m pstats %s)" % (path, path))
+            _note("perf", f"profile written to {path} (read it with: python3 -m pstats {path})")
     _run("perf", profile)
 
 

@@ -67,7 +67,7 @@ class LockstepClient:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SyntaxWarning)  # rospy's note about queue_size=None: chosen here
             publisher = rospy.Publisher(topic, message_type, queue_size=None)
-        self._wait(lambda: publisher.get_num_connections() >= subscribers, "%s to be subscribed" % topic)
+        self._wait(lambda: publisher.get_num_connections() >= subscribers, f"{topic} to be subscribed")
         return publisher
 
     def recorder(self, topics: List[str], publishers: Dict[str, int] = None) -> Recorder:
@@ -76,7 +76,7 @@ class LockstepClient:
         for topic, subscriber in zip(topics, recorder.subscribers):
             wanted = (publishers or {}).get(topic, 1)
             self._wait(lambda: subscriber.subscriber.get_num_connections() >= wanted,
-                       "%s to have %d publishers" % (topic, wanted))
+                       f"{topic} to have {wanted} publishers")
         self._recorders.append(recorder)
         return recorder
 
@@ -90,7 +90,7 @@ class LockstepClient:
     def settle(self):
         """Wait until every recorder has handled all the bridge sent before now."""
         if not drain([s for recorder in self._recorders for s in recorder.subscribers], timeout=self.timeout):
-            raise RuntimeError("recorded topics still busy after %.0f s" % self.timeout)
+            raise RuntimeError(f"recorded topics still busy after {self.timeout:.0f} s")
 
     def close(self):
         for recorder in self._recorders:
@@ -101,5 +101,5 @@ class LockstepClient:
         deadline = time.monotonic() + self.timeout
         while not condition():
             if time.monotonic() > deadline:
-                raise RuntimeError("timed out after %.0f s waiting for %s" % (self.timeout, what))
+                raise RuntimeError(f"timed out after {self.timeout:.0f} s waiting for {what}")
             time.sleep(0.01)

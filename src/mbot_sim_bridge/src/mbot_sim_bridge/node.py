@@ -41,7 +41,7 @@ def _bool_param(name: str, default: bool) -> bool:
     try:
         return parse_bool(str(value))
     except ValueError as error:
-        raise BridgeError("parameter %s: %s, got '%s'" % (rospy.resolve_name(name), error, value)) from None
+        raise BridgeError(f"parameter {rospy.resolve_name(name)}: {error}, got '{value}'") from None
 
 
 class SimBridgeNode:
@@ -63,8 +63,8 @@ class SimBridgeNode:
         world = parse_world(self.world_path, default_model_path())
         gui = requested_gui and not headless and bool(os.environ.get("DISPLAY"))
         if requested_gui and not gui:
-            rospy.loginfo("gui:=true, but %s: running without a window"
-                          % ("headless:=true" if headless else "no DISPLAY is set"))
+            why = "headless:=true" if headless else "no DISPLAY is set"
+            rospy.loginfo(f"gui:=true, but {why}: running without a window")
         self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate)
         self.sim.paused = paused or lockstep
         physics = world.physics
@@ -81,11 +81,11 @@ class SimBridgeNode:
         # gazebo_ros sets /use_sim_time only when nobody has.
         if not rospy.has_param("/use_sim_time"):
             rospy.set_param("/use_sim_time", True)
-        rospy.loginfo("world %s: step %.4f s, gravity %s, real-time factor %s, /clock %s, %s, %s",
-                      self.world_path, physics.max_step_size, physics.gravity,
-                      self.real_time_factor or "0 (as fast as possible)",
-                      "every step" if clock_frequency <= 0 else "at %.0f Hz" % clock_frequency,
-                      "lockstep" if lockstep else "paused" if paused else "running", "GUI" if gui else "headless")
+        clock = "every step" if clock_frequency <= 0 else f"at {clock_frequency:.0f} Hz"
+        state = "lockstep" if lockstep else "paused" if paused else "running"
+        rospy.loginfo(f"world {self.world_path}: step {physics.max_step_size:.4f} s, gravity {physics.gravity}, "
+                      f"real-time factor {self.real_time_factor or '0 (as fast as possible)'}, /clock {clock}, "
+                      f"{state}, {'GUI' if gui else 'headless'}")
         # Last: its services take calls at once, from other threads, and those use everything above.
         self.api = GazeboRosApi(self)
 

@@ -43,18 +43,18 @@ def describe(message: JointState) -> str:
     """What a foreign joint_states message does to robot_state_publisher, in a few words."""
     names = ", ".join(message.name) or "no joints"
     if not message.position:
-        return ("joint names without positions (%s), which robot_state_publisher drops with a warning every "
-                "300 s" % names)
+        return (f"joint names without positions ({names}), which robot_state_publisher drops "
+                "with a warning every 300 s")
     what = "zero positions" if not any(message.position) else "positions"
-    return ("%s for %s, the same joints the simulator publishes, so robot_state_publisher's TF for them jumps "
-            "between the two (in rviz the wheels flicker)" % (what, names))
+    return (f"{what} for {names}, the same joints the simulator publishes, so robot_state_publisher's TF for them "
+            "jumps between the two (in rviz the wheels flicker)")
 
 
 def warning_text(topic: str, node: str, own_node_name: str, what: str) -> str:
-    return ("%s has a second publisher, node %s, beside the simulator (%s), which already publishes every moving "
-            "joint: %s. Remove that node from the launch file that starts it (in the course's files, the "
-            "<node name=\"joint_state_publisher\" .../> line); the simulator's joint states are all "
-            "robot_state_publisher needs." % (topic, node, own_node_name, what))
+    return (f"{topic} has a second publisher, node {node}, beside the simulator ({own_node_name}), which already "
+            f"publishes every moving joint: {what}. Remove that node from the launch file that starts it (in the "
+            "course's files, the <node name=\"joint_state_publisher\" .../> line); the simulator's joint states are "
+            "all robot_state_publisher needs.")
 
 
 class _PublisherCheck:
@@ -85,7 +85,7 @@ class _PublisherCheck:
         try:
             publishers = dict(rosgraph.Master(own_node_name).getSystemState()[0])
         except Exception as error:  # the master gone or slow: the next call tries again
-            rospy.logdebug("joint_states check: master query failed: %s", error)
+            rospy.logdebug(f"joint_states check: master query failed: {error}")
             with self._lock:
                 self._busy = False
             return
@@ -104,7 +104,7 @@ class _PublisherCheck:
                                                                      callback_args=topic, queue_size=10)
             for key, first_seen in list(self._pending.items()):
                 if now - first_seen > SAMPLE_SECONDS:
-                    self._report(key, "no message from it arrived within %.0f s" % SAMPLE_SECONDS)
+                    self._report(key, f"no message from it arrived within {SAMPLE_SECONDS:.0f} s")
             self._drop_idle_samplers()
             self._busy = False
 
@@ -112,7 +112,7 @@ class _PublisherCheck:
         key = (topic, message._connection_header.get("callerid", ""))
         with self._lock:
             if key in self._pending:
-                self._report(key, "it sends %s" % describe(message))
+                self._report(key, f"it sends {describe(message)}")
                 self._drop_idle_samplers()
 
     def _report(self, key: Tuple[str, str], what: str):

@@ -69,7 +69,7 @@ def _resolve_package_uris(xml: str) -> str:
         try:
             return packages.get_path(match.group(1)) + "/"
         except rospkg.ResourceNotFound:
-            raise ModelError("package://%s/ in the model: no such package" % match.group(1)) from None
+            raise ModelError(f"package://{match.group(1)}/ in the model: no such package") from None
     return re.sub(r"package://([^/]+)/", replace, xml)
 
 
@@ -113,16 +113,16 @@ class GazeboRosApi:
     def _new_model_pose(self, request) -> Pose:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
         if request.model_name in self.sim.model_names():
-            raise ModelError("SpawnModel: Failure - entity already exists: %s" % request.model_name)
+            raise ModelError(f"SpawnModel: Failure - entity already exists: {request.model_name}")
         pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
-        check_state("SpawnModel: model '%s'" % request.model_name, pose)
+        check_state(f"SpawnModel: model '{request.model_name}'", pose)
         return pose
 
     def _spawn_urdf_model(self, request):
         def spawn():
             name = request.model_name
             pose = self._new_model_pose(request)
-            model = parse_robot(_resolve_package_uris(request.model_xml), "model '%s'" % name)
+            model = parse_robot(_resolve_package_uris(request.model_xml), f"model '{name}'")
             namespace = request.robot_namespace
             if namespace:
                 _inject_namespace(model, namespace)
@@ -142,8 +142,8 @@ class GazeboRosApi:
                 world_file.flush()
                 description = parse_world(world_file.name, default_model_path())
             if name not in self.sim.add_world(description):
-                raise ModelError("model '%s' has no collision geometry; nothing to simulate" % name)
-            rospy.loginfo("spawned SDF model '%s' at %s", name, tuple(round(v, 3) for v in pose.position))
+                raise ModelError(f"model '{name}' has no collision geometry; nothing to simulate")
+            rospy.loginfo(f"spawned SDF model '{name}' at {tuple(round(v, 3) for v in pose.position)}")
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
 
@@ -158,8 +158,8 @@ class GazeboRosApi:
         """The bridge's own: exactly ``steps`` physics steps of the paused simulation, after the messages that
         reached the bridge before the request (see subscriptions.drain)."""
         if not drain(timeout=LOCKSTEP_DRAIN_SECONDS):
-            rospy.logwarn("step_simulation: subscribers still busy after %.0f s; stepping anyway",
-                          LOCKSTEP_DRAIN_SECONDS)
+            rospy.logwarn("step_simulation: subscribers still busy after "
+                          f"{LOCKSTEP_DRAIN_SECONDS:.0f} s; stepping anyway")
 
         def step():
             if not self.sim.paused:
@@ -167,7 +167,7 @@ class GazeboRosApi:
                                  "lockstep:=true) to step it")
             self.node.step(request.steps)
             return StepSimulationResponse(success=True, sim_time=self.sim.sim_time,
-                                          status_message="StepSimulation: %d steps done" % request.steps)
+                                          status_message=f"StepSimulation: {request.steps} steps done")
         # No time limit: the caller asked for that many steps and waits for them, however long they take.
         return self._guarded(StepSimulationResponse, step, timeout=None)
 
@@ -177,7 +177,7 @@ class GazeboRosApi:
             return IDENTITY
         if frame in self.sim.model_names():
             return self.sim.engine.model_pose(frame)
-        raise ModelError("reference frame '%s' is neither the world nor a model" % frame)
+        raise ModelError(f"reference frame '{frame}' is neither the world nor a model")
 
     def _get_model_state(self, request):
         def get():

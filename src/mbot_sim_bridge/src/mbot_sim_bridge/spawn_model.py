@@ -36,7 +36,7 @@ def parse_arguments(argv):
     source.add_argument("-database", metavar="NAME", help="the model://NAME model (SDF)")
     parser.add_argument("-model", required=True, metavar="NAME", help="name of the model in the simulator")
     for axis in ("x", "y", "z", "R", "P", "Y"):
-        parser.add_argument("-" + axis, type=float, default=0.0, help="initial %s (m or rad)" % axis)
+        parser.add_argument("-" + axis, type=float, default=0.0, help=f"initial {axis} (m or rad)")
     parser.add_argument("-J", nargs=2, action="append", metavar=("JOINT", "POSITION"), default=[],
                         help="not supported by the bridge (refused with an error)")
     parser.add_argument("-reference_frame", default="", help="pose relative to this model ('' = world)")
@@ -53,7 +53,7 @@ def parse_arguments(argv):
     parser.add_argument("-b", dest="bond", action="store_true", help="delete the model when this node stops")
     arguments = parser.parse_args(argv)
     if arguments.timeout is not None and not 0 < arguments.timeout < float("inf"):
-        parser.error("-timeout must be a number of seconds > 0, got %s" % arguments.timeout)
+        parser.error(f"-timeout must be a number of seconds > 0, got {arguments.timeout}")
     if arguments.J:
         parser.error("-J (set_model_configuration) is not supported by the bridge")
     return arguments
@@ -61,31 +61,31 @@ def parse_arguments(argv):
 
 def read_model_xml(arguments) -> str:
     if arguments.database:
-        return ("<sdf version='1.6'><world name='default'><include><uri>model://%s</uri></include></world></sdf>"
-                % arguments.database)
+        return ("<sdf version='1.6'><world "
+                f"name='default'><include><uri>model://{arguments.database}</uri></include></world></sdf>")
     if arguments.file:
         try:
             with open(arguments.file) as model_file:
                 xml = model_file.read()
         except OSError as error:
-            raise SpawnError("cannot read model file %s: %s" % (arguments.file, error.strerror)) from None
-        where = "model file %s" % arguments.file
+            raise SpawnError(f"cannot read model file {arguments.file}: {error.strerror}") from None
+        where = f"model file {arguments.file}"
     elif arguments.param:
         if not rospy.has_param(arguments.param):
-            raise SpawnError("parameter %s is not set (load the robot_description first)"
-                             % rospy.resolve_name(arguments.param))
+            raise SpawnError(f"parameter {rospy.resolve_name(arguments.param)} is not set (load the "
+                             "robot_description first)")
         xml = str(rospy.get_param(arguments.param))
-        where = "parameter %s" % rospy.resolve_name(arguments.param)
+        where = f"parameter {rospy.resolve_name(arguments.param)}"
     else:
         xml = sys.stdin.read()
         where = "standard input"
     if not xml.strip():
-        raise SpawnError("%s is empty" % where)
+        raise SpawnError(f"{where} is empty")
     try:
         # Parsed and re-serialised as gazebo_ros does: drops the XML declaration and comments.
         return ElementTree.tostring(ElementTree.fromstring(xml), encoding="unicode")
     except ElementTree.ParseError as error:
-        raise SpawnError("%s is not valid XML: %s" % (where, error)) from None
+        raise SpawnError(f"{where} is not valid XML: {error}") from None
 
 
 def initial_pose(arguments) -> Pose:
@@ -99,7 +99,7 @@ def initial_pose(arguments) -> Pose:
 
 def wait_for_model(arguments):
     from gazebo_msgs.msg import ModelStates
-    rospy.loginfo("waiting for model %s", arguments.wait)
+    rospy.loginfo(f"waiting for model {arguments.wait}")
     while not rospy.is_shutdown():
         try:
             states = rospy.wait_for_message(arguments.gazebo_namespace + "/model_states", ModelStates, timeout=1.0)
@@ -110,7 +110,7 @@ def wait_for_model(arguments):
 
 
 def wait_for_service(name: str, timeout):
-    rospy.loginfo("waiting for service %s", name)
+    rospy.loginfo(f"waiting for service {name}")
     deadline = None if timeout is None else time.monotonic() + timeout
     master = rosgraph.Master(rospy.get_name())
     # rospy.wait_for_service polls every 0.3 s. spawn_model starts together with the simulator, so that poll
@@ -118,8 +118,8 @@ def wait_for_service(name: str, timeout):
     while not rospy.is_shutdown():
         remaining = None if deadline is None else deadline - time.monotonic()
         if remaining is not None and remaining <= 0:
-            raise SpawnError("service %s did not appear within %g s (-timeout): is the simulator running "
-                             "(roslaunch gazebo_ros empty_world.launch)?" % (name, timeout))
+            raise SpawnError(f"service {name} did not appear within {timeout:g} s (-timeout): is the simulator running "
+                             "(roslaunch gazebo_ros empty_world.launch)?")
         try:
             master.lookupService(name)
         except (rosgraph.MasterError, OSError):  # not registered yet, or the master not up yet
@@ -136,7 +136,7 @@ def wait_for_service(name: str, timeout):
 
 
 def spawn(arguments):
-    service_name = "%s/spawn_%s_model" % (arguments.gazebo_namespace, "urdf" if arguments.urdf else "sdf")
+    service_name = f"{arguments.gazebo_namespace}/spawn_{'urdf' if arguments.urdf else 'sdf'}_model"
     model_xml = read_model_xml(arguments)
     if arguments.wait:
         wait_for_model(arguments)
@@ -145,8 +145,8 @@ def spawn(arguments):
     response = rospy.ServiceProxy(service_name, SpawnModel)(arguments.model, model_xml, namespace,
                                                             initial_pose(arguments), arguments.reference_frame)
     if not response.success:
-        raise SpawnError("spawning '%s' failed: %s" % (arguments.model, response.status_message))
-    rospy.loginfo("spawned '%s': %s", arguments.model, response.status_message)
+        raise SpawnError(f"spawning '{arguments.model}' failed: {response.status_message}")
+    rospy.loginfo(f"spawned '{arguments.model}': {response.status_message}")
     if arguments.unpause:
         unpause_name = arguments.gazebo_namespace + "/unpause_physics"
         wait_for_service(unpause_name, arguments.timeout)
@@ -159,7 +159,7 @@ def main():
     try:
         spawn(arguments)
     except (SpawnError, rospy.ServiceException) as error:
-        print("spawn_model: %s" % error, file=sys.stderr)
+        print(f"spawn_model: {error}", file=sys.stderr)
         sys.exit(1)
     except rospy.ROSInterruptException:
         sys.exit(1)
@@ -168,6 +168,6 @@ def main():
             try:
                 rospy.ServiceProxy(arguments.gazebo_namespace + "/delete_model", DeleteModel)(arguments.model)
             except (rospy.ServiceException, rospy.ROSException) as error:
-                print("spawn_model: could not delete '%s' on exit: %s" % (arguments.model, error), file=sys.stderr)
+                print(f"spawn_model: could not delete '{arguments.model}' on exit: {error}", file=sys.stderr)
         rospy.on_shutdown(delete_model)
         rospy.spin()

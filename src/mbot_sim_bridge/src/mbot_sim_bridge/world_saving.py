@@ -32,22 +32,21 @@ class SaveWorldHandler:
         try:
             message = self.save(request.path, request.with_robots)
         except BridgeError as error:
-            rospy.logerr("save_world: %s", error)
+            rospy.logerr(f"save_world: {error}")
             return SaveWorldResponse(success=False, status_message=str(error))
-        rospy.loginfo("save_world: %s", message)
+        rospy.loginfo(f"save_world: {message}")
         return SaveWorldResponse(success=True, status_message=message)
 
     def save(self, path: str, with_robots: bool) -> str:
         if not os.path.isabs(path):
-            raise WorldError("path '%s' is not absolute (the simulator's working directory is not the "
-                             "caller's)" % path)
+            raise WorldError(f"path '{path}' is not absolute (the simulator's working directory is not the caller's)")
         snapshot: WorldSnapshot = self.call_in_loop(lambda: take_snapshot(self.simulation, with_robots))
         write_world_file(path, world_sdf(self.world, snapshot.models, snapshot.poses, snapshot.robots))
         left_out = [] if with_robots else snapshot.robot_names
-        message = "wrote %s: %d models" % (path, len(snapshot.models) + len(snapshot.robots))
+        message = f"wrote {path}: {len(snapshot.models) + len(snapshot.robots)} models"
         if left_out:
-            message += "; robots left out (with_robots adds them): %s" % ", ".join(left_out)
+            message += f"; robots left out (with_robots adds them): {', '.join(left_out)}"
         if snapshot.robots:
-            rospy.logwarn("save_world: %s", PLUGINS_AS_TAGS)
+            rospy.logwarn(f"save_world: {PLUGINS_AS_TAGS}")
             message += "; warning: " + PLUGINS_AS_TAGS
         return message

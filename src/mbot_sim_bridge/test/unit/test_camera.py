@@ -162,7 +162,7 @@ def world_simulation_description(tmp_path, *models):
     """A WorldDescription holding ``models`` (spawn_sdf_model's way of adding them)."""
     path = os.path.join(str(tmp_path), "added.world")
     with open(path, "w") as world:
-        world.write("<?xml version='1.0'?><sdf version='1.6'><world name='w'>%s</world></sdf>" % "".join(models))
+        world.write(f"<?xml version='1.0'?><sdf version='1.6'><world name='w'>{''.join(models)}</world></sdf>")
     return parse_world(path)
 
 

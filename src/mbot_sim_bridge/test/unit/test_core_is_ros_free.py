@@ -21,4 +21,4 @@ def _imported_modules(path):
 def test_core_module_imports_no_ros(module):
     for name in _imported_modules(os.path.join(CORE, module)):
         top = name.split(".")[0]
-        assert top not in FORBIDDEN and not top.endswith("_msgs"), "%s imports %s" % (module, name)
+        assert top not in FORBIDDEN and not top.endswith("_msgs"), f"{module} imports {name}"

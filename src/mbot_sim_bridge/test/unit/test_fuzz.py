@@ -68,7 +68,7 @@ class Hang(Exception):
 def watchdog(seconds=CASE_SECONDS):
     """Interrupts a case that blocks (a FIFO read, an endless loop in Python) by raising Hang."""
     def expire(*_):
-        raise Hang("case did not finish within %.0f s" % seconds)
+        raise Hang(f"case did not finish within {seconds:.0f} s")
     previous = signal.signal(signal.SIGALRM, expire)
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
@@ -84,8 +84,8 @@ def tally(kind, outcome):
 
 def refused(kind, error):
     message = str(error)
-    assert message and "\n" not in message, "a refusal must be one line: %r" % message
-    tally(kind, "refused (%s)" % type(error).__name__)
+    assert message and "\n" not in message, f"a refusal must be one line: {message!r}"
+    tally(kind, f"refused ({type(error).__name__})")
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -102,8 +102,8 @@ def print_outcomes(request):
     capture = request.config.pluginmanager.getplugin("capturemanager")
     with capture.global_and_fixture_disabled():
         for kind, counts in OUTCOMES.items():
-            details = ", ".join("%d %s" % (count, outcome) for outcome, count in sorted(counts.items()))
-            print("\nfigure: fuzz %s: %d cases: %s" % (kind, sum(counts.values()), details))
+            details = ", ".join(f"{count} {outcome}" for outcome, count in sorted(counts.items()))
+            print(f"\nfigure: fuzz {kind}: {sum(counts.values())} cases: {details}")
 
 
 # -- mutations ----------------------------------------------------------------------------------------------------
@@ -159,12 +159,11 @@ def assert_finite_state(sim, label):
         pose = sim.engine.model_pose(name)
         linear, angular = sim.engine.model_velocity(name)
         values = tuple(pose.position) + tuple(pose.orientation) + tuple(linear) + tuple(angular)
-        assert all(math.isfinite(v) for v in values), "%s: model '%s' has a non-finite state %s" % (label, name,
-                                                                                                    values)
+        assert all(math.isfinite(v) for v in values), f"{label}: model '{name}' has a non-finite state {values}"
     for spawned in sim.models.values():
         robot = spawned.robot
         for position, velocity, _ in robot.joint_state(list(robot.movable_joints)):
-            assert math.isfinite(position) and math.isfinite(velocity), "%s: '%s' joints" % (label, spawned.name)
+            assert math.isfinite(position) and math.isfinite(velocity), f"{label}: '{spawned.name}' joints"
 
 
 def step_and_check(sim, label, command=(0.5, 1.0)):
@@ -177,11 +176,11 @@ def step_and_check(sim, label, command=(0.5, 1.0)):
     assert_finite_state(sim, label)
     for name, spawned in sim.models.items():
         # A plugin that failed was disabled by the loop's guard: the validation let a bad value through.
-        assert spawned.plugins == plugins[name], "%s: a plugin of '%s' failed while stepping" % (label, name)
+        assert spawned.plugins == plugins[name], f"{label}: a plugin of '{name}' failed while stepping"
         for plugin in spawned.plugins:
             if isinstance(plugin, DiffDrive):
                 values = np.hstack([np.ravel(part) for part in plugin.odometry()[0]] + list(plugin.odometry()[1:]))
-                assert np.all(np.isfinite(values)), "%s: odometry %s" % (label, values)
+                assert np.all(np.isfinite(values)), f"{label}: odometry {values}"
 
 
 # -- robot descriptions -------------------------------------------------------------------------------------------
@@ -269,7 +268,7 @@ def test_malformed_worlds(data, world_directory):
         return
     try:
         with watchdog():
-            step_and_check(sim, "mutated %s" % os.path.basename(base))
+            step_and_check(sim, f"mutated {os.path.basename(base)}")
         tally("worlds", "loaded")
     finally:
         sim.close()
@@ -307,7 +306,7 @@ REQUESTS = st.one_of(
     st.tuples(st.just("spawn_sdf"), NAMES, VECTOR, QUATERNION,
               st.sampled_from(("<sdf version='1.6'><model name='m'><link name='l'><collision name='c'><geometry>"
                                "<box><size>1 1 1</size></box></geometry></collision></link></model></sdf>",
-                               "<sdf><model name='m'><pose>%s</pose></model></sdf>" % BAD_VECTORS[0],
+                               f"<sdf><model name='m'><pose>{BAD_VECTORS[0]}</pose></model></sdf>",
                                "<robot name='r'/>", "", "<sdf>", "<sdf version='1.6'><world name='w'/></sdf>"))),
     st.tuples(st.just("delete"), NAMES),
     st.tuples(st.just("command"), NUMBERS, NUMBERS),
@@ -322,7 +321,7 @@ def _apply(sim, request, mbot_urdf):
         sim.engine.set_model_state(model, service_pose(position, quaternion), linear, angular)
     elif name == "spawn_robot":
         _, model, position, quaternion = request
-        sim.spawn_robot(parse_robot(mbot_urdf, "model '%s'" % model), model, service_pose(position, quaternion))
+        sim.spawn_robot(parse_robot(mbot_urdf, f"model '{model}'"), model, service_pose(position, quaternion))
     elif name == "spawn_sdf":
         _, model, position, quaternion, xml = request
         world_xml = spawn_world_xml(xml, model, service_pose(position, quaternion))
@@ -352,16 +351,16 @@ def test_garbage_requests(requests, mbot_model, mbot_urdf):
             try:
                 with watchdog():
                     _apply(sim, request, mbot_urdf)
-                tally("service requests", "done (%s)" % request[0])
+                tally("service requests", f"done ({request[0]})")
             except BridgeError as error:
                 refused("service requests", error)
         with watchdog():
             sim.step(STEPS // 4)
-            assert_finite_state(sim, "after %s" % (requests,))
+            assert_finite_state(sim, f"after {requests}")
             # Whatever the requests did, reset_world brings every model back to a finite spawn state.
             sim.reset(simulation=False)
             sim.step(10)
-            assert_finite_state(sim, "reset after %s" % (requests,))
+            assert_finite_state(sim, f"reset after {requests}")
     finally:
         sim.close()
 

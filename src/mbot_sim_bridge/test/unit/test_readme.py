@@ -13,7 +13,7 @@ README = os.path.join(os.path.dirname(__file__), "..", "..", "README.md")
 def test_readme_lists_every_tag_of_every_plugin_with_its_default_and_range(filename):
     plugin_class = REGISTRY[filename]
     text = open(README).read()
-    assert "`%s`" % filename in text, "%s is not in the supported-plugin table" % filename
+    assert f"`{filename}`" in text, f"{filename} is not in the supported-plugin table"
     assert params_table_markdown(plugin_class.PARAMS) in text
     if plugin_class.SENSOR_PARAMS:
         assert params_table_markdown(plugin_class.SENSOR_PARAMS) in text

@@ -11,7 +11,7 @@ INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
 
 
 def robot(*parts, name="probe"):
-    return '<robot name="%s">%s</robot>' % (name, "".join(parts))
+    return f"<robot name=\"{name}\">{''.join(parts)}</robot>"
 
 
 def link(name, geometry='<box size="0.1 0.1 0.1"/>', inertial=INERTIAL):
@@ -19,8 +19,8 @@ def link(name, geometry='<box size="0.1 0.1 0.1"/>', inertial=INERTIAL):
 
 
 def joint(name, kind, parent, child, xyz="0 0 0"):
-    return ('<joint name="%s" type="%s"><parent link="%s"/><child link="%s"/><origin xyz="%s"/>'
-            '<axis xyz="0 1 0"/></joint>' % (name, kind, parent, child, xyz))
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><origin '
+            f'xyz="{xyz}"/><axis xyz="0 1 0"/></joint>')
 
 
 def test_course_mbot_lumps_fixed_links_like_gazebo(mbot_urdf):

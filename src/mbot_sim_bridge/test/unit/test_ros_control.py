@@ -45,7 +45,7 @@ def simulate(urdf, params, name="robot"):
     sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")),
                      {"libgazebo_ros_control.so": CoreRosControl,
                       "libgazebo_ros_joint_state_publisher.so": JointStatePublisher})
-    spawned = sim.spawn_robot(parse_robot(urdf, "model '%s'" % name), name)
+    spawned = sim.spawn_robot(parse_robot(urdf, f"model '{name}'"), name)
     plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, RosControl))
     return sim, spawned, plugin
 
@@ -299,7 +299,7 @@ def test_wheel_odometry_over_3_m_stays_within_2_percent(mbot):
 # -- the two-joint arm -------------------------------------------------------------------------------------------
 def arm(interface):
     urdf = expand_xacro_arm(interface)
-    return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", "arm_%s.yaml" % interface.lower())), "arm")
+    return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", f"arm_{interface.lower()}.yaml")), "arm")
 
 
 def expand_xacro_arm(interface):
@@ -330,7 +330,7 @@ def test_the_arm_reaches_setpoints_within_a_degree(interface, controllers):
             sim.step(2000)
             reached = [state[0] for state in spawned.robot.joint_state(["shoulder", "elbow"])]
             errors = [math.degrees(abs(a - b)) for a, b in zip(reached, setpoint)]
-            assert max(errors) < 1.0, "setpoint %s: errors %s degrees" % (setpoint, errors)
+            assert max(errors) < 1.0, f"setpoint {setpoint}: errors {errors} degrees"
     finally:
         sim.close()
 

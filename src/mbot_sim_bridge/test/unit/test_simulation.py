@@ -83,7 +83,7 @@ def _first_scan(urdf, names_in_order, measured, seed=7):
     try:
         for name in names_in_order:
             y = 0.0 if name == measured else 50.0 + len(sim.models)
-            sim.spawn_robot(parse_robot(urdf, "model '%s'" % name), name, pose_from_xyz_rpy((0, y, 0), (0, 0, 0)))
+            sim.spawn_robot(parse_robot(urdf, f"model '{name}'"), name, pose_from_xyz_rpy((0, y, 0), (0, 0, 0)))
         lidar = plugin_of(sim.models[measured], RaySensor)
         first = lidar.scan().ranges
         for _ in range(3):

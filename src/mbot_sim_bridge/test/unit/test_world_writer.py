@@ -43,9 +43,9 @@ def angle_between(a: Pose, b: Pose) -> float:
 
 def assert_same_pose(actual: Pose, expected: Pose, what: str):
     distance = float(np.linalg.norm(np.subtract(actual.position, expected.position)))
-    assert distance < POSITION_TOLERANCE, "%s: %.4f m from %s" % (what, distance, expected.position)
-    assert angle_between(actual, expected) < ANGLE_TOLERANCE, "%s: turned by %.4f rad" % (what, angle_between(
-        actual, expected))
+    assert distance < POSITION_TOLERANCE, f"{what}: {distance:.4f} m from {expected.position}"
+    turned = angle_between(actual, expected)
+    assert turned < ANGLE_TOLERANCE, f"{what}: turned by {turned:.4f} rad"
 
 
 def save_and_reload(simulation, world, tmp_path, with_robots=False, name="saved.world"):
@@ -129,7 +129,7 @@ def test_inline_models_stay_inline_with_their_links_where_they_are_now(tmp_path)
         # Each link where it is now: the original link pose carried along with its model.
         for link, old_link in zip(model.links, before.links):
             expected = compose(snapshot.poses[model.name], compose(inverse(before.pose), old_link.pose))
-            assert_same_pose(link.pose, expected, "%s::%s" % (model.name, link.name))
+            assert_same_pose(link.pose, expected, f"{model.name}::{link.name}")
     simulation.close()
 
 
@@ -146,7 +146,7 @@ def test_spawned_database_models_are_saved_as_includes(tmp_path):
     simulation = Simulation(world, {})
     for name, x in (("unit_box", 1.0), ("unit_box_0", 3.0)):
         xml = "<sdf version='1.6'><world name='default'><include><uri>model://unit_box</uri></include></world></sdf>"
-        spawn = tmp_path / ("spawn_%s.world" % name)
+        spawn = tmp_path / (f"spawn_{name}.world")
         spawn.write_text(spawn_world_xml(xml, name, pose_from_xyz_rpy((x, 2.0, 0.0), (0, 0, 0.5))))
         simulation.add_world(parse_world(str(spawn)))
     simulation.step(20)

@@ -47,7 +47,7 @@ def _scale(name, course_name, default):
     if not found:
         return default, 'default'
     if len(found) == 2:
-        rospy.logwarn('%s: ~%s is set, so ~%s is ignored', NODE_NAME, name, course_name)
+        rospy.logwarn(f"{NODE_NAME}: ~{name} is set, so ~{course_name} is ignored")
     return _number(found[0], rospy.get_param('~' + found[0])), '~' + found[0]
 
 
@@ -62,7 +62,7 @@ def read_params():
 
 def speeds_line(teleop):
     """The course's status line; rounding hides float noise such as 0.22000000000000003."""
-    return 'currently:\tspeed %s\tturn %s' % (round(teleop.speed, 4), round(teleop.turn, 4))
+    return f'currently:\tspeed {round(teleop.speed, 4)}\tturn {round(teleop.turn, 4)}'
 
 
 def _twist(linear, angular):
@@ -107,7 +107,7 @@ def main():
         rospy.signal_shutdown('interrupted while starting')
         return 1
     except ParamError as error:
-        rospy.logfatal('%s: %s', NODE_NAME, error)
+        rospy.logfatal(f"{NODE_NAME}: {error}")
         rospy.signal_shutdown('bad parameter')
         return 1
     # Synchronous (queue_size=None): each Twist is on the wire when publish() returns, so keys typed ahead
@@ -116,9 +116,9 @@ def main():
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', SyntaxWarning)
         publisher = rospy.Publisher('cmd_vel', Twist, queue_size=None)
-    rospy.loginfo('%s: speed %g m/s (%s), turn %g rad/s (%s), key_timeout %g s, publishing on %s',
-                  NODE_NAME, params.speed, params.speed_from, params.turn, params.turn_from,
-                  params.key_timeout, publisher.resolved_name)
+    rospy.loginfo(f"{NODE_NAME}: speed {params.speed:g} m/s ({params.speed_from}), turn {params.turn:g} rad/s "
+                  f"({params.turn_from}), key_timeout {params.key_timeout:g} s, publishing on "
+                  f"{publisher.resolved_name}")
 
     teleop = Teleop(params.speed, params.turn, idle_limit_for(params.key_timeout))
     fd = sys.stdin.fileno()

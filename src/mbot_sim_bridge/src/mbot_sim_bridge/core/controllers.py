@@ -38,7 +38,7 @@ def param(params: dict, path: str, default=_MISSING, kind: type = float, where: 
         return value
     if isinstance(value, kind):
         return value
-    warn_once(_logger, "%s: parameter '%s' is %r, not a %s; using %r" % (where, path, value, kind.__name__, default))
+    warn_once(_logger, f"{where}: parameter '{path}' is {value!r}, not a {kind.__name__}; using {default!r}")
     return None if default is _MISSING else default
 
 
@@ -114,21 +114,21 @@ class JointStateController(Controller):
         extra = []
         for element in specification:
             if not isinstance(element, dict):
-                _logger.error("Extra joint specification is not a struct, but rather '%s'. Ignoring.",
-                              type(element).__name__)
+                _logger.error("Extra joint specification is not a struct, but rather "
+                              f"'{type(element).__name__}'. Ignoring.")
                 continue
             if "name" not in element:
                 _logger.error("Extra joint does not specify name. Ignoring.")
                 continue
             joint = str(element["name"])
             if joint in self.joint_names or joint in [entry[0] for entry in extra]:
-                _logger.warning("Joint state interface already contains specified extra joint '%s'.", joint)
+                _logger.warning(f"Joint state interface already contains specified extra joint '{joint}'.")
                 continue
             values = []
             for key, label in (("position", "position"), ("velocity", "velocity"), ("effort", "effort")):
                 value = element.get(key, 0.0)
                 if not isinstance(value, float):
-                    _logger.error("Extra joint '%s' does not specify a valid default %s. Ignoring.", joint, label)
+                    _logger.error(f"Extra joint '{joint}' does not specify a valid default {label}. Ignoring.")
                     break
                 values.append(value)
             else:
@@ -269,17 +269,17 @@ class DiffDriveOdometry:
 def _wheel_names(params: dict, key: str) -> List[str]:
     value = params.get(key)
     if value is None:
-        raise ControllerInitError("Couldn't retrieve wheel param '%s'." % key)
+        raise ControllerInitError(f"Couldn't retrieve wheel param '{key}'.")
     if isinstance(value, str):
         return [value]
     if isinstance(value, list):
         if not value:
-            raise ControllerInitError("Wheel param '%s' is an empty list" % key)
+            raise ControllerInitError(f"Wheel param '{key}' is an empty list")
         for index, item in enumerate(value):
             if not isinstance(item, str):
-                raise ControllerInitError("Wheel param '%s' #%d isn't a string." % (key, index))
+                raise ControllerInitError(f"Wheel param '{key}' #{index} isn't a string.")
         return list(value)
-    raise ControllerInitError("Wheel param '%s' is neither a list of strings nor a string." % key)
+    raise ControllerInitError(f"Wheel param '{key}' is neither a list of strings nor a string.")
 
 
 def _covariance_diagonal(params: dict, key: str, name: str) -> List[float]:
@@ -288,7 +288,7 @@ def _covariance_diagonal(params: dict, key: str, name: str) -> List[float]:
         return [0.0] * 6  # upstream reads an unset list as zeros
     if (not isinstance(value, list) or len(value) != 6
             or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-        raise ControllerInitError("%s: '%s' must be a list of 6 numbers, got %r" % (name, key, value))
+        raise ControllerInitError(f"{name}: '{key}' must be a list of 6 numbers, got {value!r}")
     return [float(v) for v in value]
 
 
@@ -299,7 +299,7 @@ class DiffDriveController(Controller):
         super().__init__(name, hw, params, context)
         left, right = _wheel_names(params, "left_wheel"), _wheel_names(params, "right_wheel")
         if len(left) != len(right):
-            raise ControllerInitError("#left wheels (%d) != #right wheels (%d)." % (len(left), len(right)))
+            raise ControllerInitError(f"#left wheels ({len(left)}) != #right wheels ({len(right)}).")
         self.left_names, self.right_names = left, right
 
         def get(key, default, kind=float):
@@ -322,16 +322,17 @@ class DiffDriveController(Controller):
         self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
         self.publish_cmd = get("publish_cmd", False, bool)
         if get("publish_wheel_joint_controller_state", False, bool):
-            warn_once(_logger, "%s: publish_wheel_joint_controller_state needs control_msgs, which Debian does not "
-                      "package; not published" % name)
+            warn_once(_logger, f"{name}: publish_wheel_joint_controller_state needs control_msgs, which Debian does "
+                               "not package; not published")
         self.wheel_separation = get("wheel_separation", None)
         self.wheel_radius = get("wheel_radius", None)
         self._geometry_from_urdf(context.urdf, left[0], right[0])
         self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
         self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
         self._apply_wheel_params()
-        _logger.info("%s: Odometry params : wheel separation %s, left wheel radius %s, right wheel radius %s", name,
-                     *self.wheel_params())
+        separation, left_radius, right_radius = self.wheel_params()
+        _logger.info(f"{name}: Odometry params : wheel separation {separation}, left wheel radius {left_radius}, "
+                     f"right wheel radius {right_radius}")
         self.left = [self.handle(joint) for joint in left]
         self.right = [self.handle(joint) for joint in right]
         self._lock = threading.Lock()
@@ -348,18 +349,17 @@ class DiffDriveController(Controller):
         left_joint, right_joint = urdf.joints.get(left), urdf.joints.get(right)
         for joint, joint_name in ((left_joint, left), (right_joint, right)):
             if joint is None:
-                raise ControllerInitError("%s couldn't be retrieved from model description" % joint_name)
+                raise ControllerInitError(f"{joint_name} couldn't be retrieved from model description")
         if self.wheel_separation is None:
             self.wheel_separation = math.dist(left_joint.origin_xyz, right_joint.origin_xyz)
         if self.wheel_radius is None:
             collision = urdf.link_collision.get(left_joint.child)
             if collision is None:
-                raise ControllerInitError("Link %s does not have collision description. Add collision description "
-                                          "for link to urdf.\nCouldn't retrieve %s wheel radius"
-                                          % (left_joint.child, left))
+                raise ControllerInitError(f"Link {left_joint.child} does not have collision description. Add collision "
+                                          f"description for link to urdf.\nCouldn't retrieve {left} wheel radius")
             if collision[0] not in ("cylinder", "sphere") or collision[1] is None:
-                raise ControllerInitError("Wheel link %s is NOT modeled as a cylinder or sphere!\nCouldn't retrieve "
-                                          "%s wheel radius" % (left_joint.child, left))
+                raise ControllerInitError(f"Wheel link {left_joint.child} is NOT modeled as a cylinder or "
+                                          f"sphere!\nCouldn't retrieve {left} wheel radius")
             self.wheel_radius = collision[1]
 
     def wheel_params(self):
@@ -376,7 +376,7 @@ class DiffDriveController(Controller):
             return "Can't accept new commands. Controller is not running."
         if not self.allow_multiple_publishers and publishers > 1:
             self.brake()
-            return "Detected %d publishers. Only 1 publisher is allowed. Going to brake." % publishers
+            return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
         if not (math.isfinite(linear) and math.isfinite(angular)):
             return "Received NaN in velocity command. Ignoring."
         with self._lock:
@@ -440,14 +440,14 @@ class DiffDriveController(Controller):
 def _joint_name(params: dict, namespace: str) -> str:
     joint = params.get("joint")
     if not isinstance(joint, str):
-        raise ControllerInitError("No joint given (namespace: %s)" % namespace)
+        raise ControllerInitError(f"No joint given (namespace: {namespace})")
     return joint
 
 
 def _joint_names(params: dict, namespace: str) -> List[str]:
     joints = params.get("joints")
     if not isinstance(joints, list) or not all(isinstance(joint, str) for joint in joints):
-        raise ControllerInitError("Failed to getParam 'joints' (namespace: %s)." % namespace)
+        raise ControllerInitError(f"Failed to getParam 'joints' (namespace: {namespace}).")
     if not joints:
         raise ControllerInitError("List of joint names is empty.")
     return list(joints)
@@ -490,12 +490,12 @@ class ForwardJointGroupCommandController(Controller):
         try:
             return self.handle(joint)
         except Exception as error:  # upstream catches HardwareInterfaceException here and fails init
-            raise ControllerInitError("Exception thrown: %s" % error) from None
+            raise ControllerInitError(f"Exception thrown: {error}") from None
 
     def set_commands(self, values: Sequence[float]) -> Optional[str]:
         if len(values) != len(self.joints):
-            return ("Dimension of command (%d) does not match number of joints (%d)! Not executing!"
-                    % (len(values), len(self.joints)))
+            return (f"Dimension of command ({len(values)}) does not match number of joints "
+                    f"({len(self.joints)})! Not executing!")
         self.commands = list(values)
         return None
 
@@ -523,7 +523,7 @@ class _UrdfJointLimits:
             raise ControllerInitError("Failed to parse urdf file")
         urdf_joint = urdf.joints.get(joint)
         if urdf_joint is None:
-            raise ControllerInitError("Could not find joint '%s' in urdf" % joint)
+            raise ControllerInitError(f"Could not find joint '{joint}' in urdf")
         self.type = urdf_joint.type
         limit = urdf_joint.limit or {}
         self.lower, self.upper = limit.get("lower", 0.0), limit.get("upper", 0.0)
@@ -612,7 +612,7 @@ class EffortGroupPositionController(ForwardJointGroupCommandController):
         for joint in self.joint_names:
             pid = Pid.from_params(param(params, joint + "/pid", None, dict), self.namespace + "/" + joint + "/pid")
             if pid is None:
-                raise ControllerInitError("Failed to load PID parameters from %s/pid" % joint)
+                raise ControllerInitError(f"Failed to load PID parameters from {joint}/pid")
             self.pids.append(pid)
 
     def starting(self, now):

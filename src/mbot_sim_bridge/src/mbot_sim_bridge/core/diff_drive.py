@@ -151,9 +151,9 @@ class DiffDrive(Plugin):
         self.namespace = params["robotNamespace"] or context.model.name
         for tag in ("leftJoint", "rightJoint"):
             if params[tag] not in robot.joint_index:
-                raise ConfigError("%s: %s: <%s> names joint '%s', which the robot does not have; movable joints: %s"
-                                  % (context.where(element), self.label, tag, params[tag],
-                                     ", ".join(robot.movable_joints) or "none"))
+                movable = ", ".join(robot.movable_joints) or "none"
+                raise ConfigError(f"{context.where(element)}: {self.label}: <{tag}> names joint '{params[tag]}', which "
+                                  f"the robot does not have; movable joints: {movable}")
         level = _LOG_LEVELS.get(params["rosDebugLevel"].lower())
         if level is not None:
             # Gazebo sets the whole server's roscpp level from this tag; the bridge sets its own loggers'

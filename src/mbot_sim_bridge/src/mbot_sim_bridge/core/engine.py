@@ -102,7 +102,7 @@ def _friction(text: str, model: str, link: str) -> float:
         value = parse_float(text)
         check_range(value, minimum=0.0)
     except ValueError as error:
-        raise ModelError("model '%s': <gazebo reference='%s'> friction '%s': %s" % (model, link, text, error)) from None
+        raise ModelError(f"model '{model}': <gazebo reference='{link}'> friction '{text}': {error}") from None
     return value
 
 
@@ -240,7 +240,7 @@ class Engine:
         None leaves the surfaces to a later ``set_surfaces``, once the plugins have said what they drive.
         """
         if name in self.robots or name in self.world_bodies:
-            raise ModelError("model '%s' already exists" % name)
+            raise ModelError(f"model '{name}' already exists")
         check_state(f"SpawnModel: model '{name}'", pose)
         robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace,
                              self._free_collision_group(), pose)
@@ -269,7 +269,7 @@ class Engine:
         elif name in self.world_bodies:
             body = self.world_bodies.pop(name)
         else:
-            raise ModelError("model '%s' does not exist" % name)
+            raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
         self.client.removeBody(body)
@@ -279,7 +279,7 @@ class Engine:
             return self.robots[name].body
         if name in self.world_bodies:
             return self.world_bodies[name]
-        raise ModelError("model '%s' does not exist" % name)
+        raise ModelError(f"model '{name}' does not exist")
 
     def model_pose(self, name: str) -> Pose:
         """World pose of a model's frame (a robot's root link, a world model's <model> frame)."""
@@ -322,7 +322,7 @@ class Engine:
             with _stdout_silenced():
                 body = self.client.loadURDF(path, flags=flags)
         except pybullet.error as error:
-            raise ModelError("PyBullet could not load model '%s': %s" % (model.name, error)) from None
+            raise ModelError(f"PyBullet could not load model '{model.name}': {error}") from None
         finally:
             os.unlink(path)
         com = compose(pose, inverse(root_from_com(self.client, body)))
@@ -334,7 +334,7 @@ class Engine:
         robot.driven_joints = tuple(driven_joints)
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
-            _logger.info("%s: ball-caster contact (frictionless) for %s", robot.name, ", ".join(sorted(casters)))
+            _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
         for link_name, index in robot.link_index.items():
             self._set_surface(robot, link_name, index, caster=link_name in casters)
 
@@ -345,8 +345,8 @@ class Engine:
             mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
             values = [_friction(v, robot.name, link_name) for v in (mu1, mu2) if v is not None]
             if len(values) == 2 and values[0] != values[1]:
-                warn_once(_logger, "%s: link '%s' has mu1 %s and mu2 %s; Bullet's friction is isotropic, the "
-                          "smaller is used" % (robot.name, link_name, mu1, mu2))
+                warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1} and mu2 {mu2}; Bullet's friction "
+                                   "is isotropic, the smaller is used")
             if values:
                 mu = min(values)
         if caster:
@@ -359,8 +359,8 @@ class Engine:
         for bit in range(_FIRST_ROBOT_GROUP_BIT, _LAST_ROBOT_GROUP_BIT + 1):
             if (1 << bit) not in used:
                 return 1 << bit
-        raise ModelError("too many robots: each needs a collision-filter bit and all %d are taken"
-                         % (_LAST_ROBOT_GROUP_BIT - _FIRST_ROBOT_GROUP_BIT + 1))
+        bits = _LAST_ROBOT_GROUP_BIT - _FIRST_ROBOT_GROUP_BIT + 1
+        raise ModelError(f"too many robots: each needs a collision-filter bit and all {bits} are taken")
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)

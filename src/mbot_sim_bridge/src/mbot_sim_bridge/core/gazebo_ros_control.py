@@ -76,11 +76,11 @@ class RosControl(Plugin):
         step = context.simulation.step_size
         self.control_period = params["controlPeriod"] if self.element.find("controlPeriod") is not None else step
         if self.control_period < step - _EPSILON:
-            _logger.error("%s: Desired controller update period (%s s) is faster than the gazebo simulation period "
-                          "(%s s).", self.label, self.control_period, step)
+            _logger.error(f"{self.label}: Desired controller update period ({self.control_period} s) is faster than "
+                          f"the gazebo simulation period ({step} s).")
         elif self.control_period > step + _EPSILON:
-            _logger.warning("%s: Desired controller update period (%s s) is slower than the gazebo simulation "
-                            "period (%s s).", self.label, self.control_period, step)
+            _logger.warning(f"{self.label}: Desired controller update period ({self.control_period} s) is slower than "
+                            f"the gazebo simulation period ({step} s).")
         urdf_text, source = self.robot_description(params["robotParam"])
         model = parse_robot(urdf_text, source) if urdf_text is not None else context.robot.model
         document: XmlDocument = model.document
@@ -94,8 +94,8 @@ class RosControl(Plugin):
         self.hw = RobotHWSim(context.robot, transmissions, self.urdf, self.label,
                              self.ros_param(base + "/joint_limits"), self.ros_param(pid_namespace), pid_namespace)
         if not self.hw.joints:
-            warn_once(_logger, "%s: the robot has no usable <transmission>; the controller manager has no joints"
-                      % self.label)
+            warn_once(_logger, f"{self.label}: the robot has no usable <transmission>; the "
+                               "controller manager has no joints")
         self.driven_joints = tuple(self.hw.names)
         self.joint_states_published = tuple(self.hw.names)
         self.manager = ControllerManager(self.hw, self.controller_class, sorted(CORE_CONTROLLERS),

@@ -27,9 +27,9 @@ class JointStatePublisher(Plugin):
         self.joint_names = [name.strip() for name in params["jointName"].split(",") if name.strip()]
         unknown = [name for name in self.joint_names if name not in context.robot.joint_index]
         if unknown:
-            raise ConfigError("%s: %s: <jointName> names %s, which the robot does not have; movable joints: %s"
-                              % (context.where(element), self.label, ", ".join(unknown),
-                                 ", ".join(context.robot.movable_joints) or "none"))
+            movable = ", ".join(context.robot.movable_joints) or "none"
+            raise ConfigError(f"{context.where(element)}: {self.label}: <jointName> names {', '.join(unknown)}, which "
+                              f"the robot does not have; movable joints: {movable}")
         self.joint_states_published = tuple(self.joint_names)
         # Strict like the diff drive's timer (one step after each period), so both publish in the same pass.
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)

@@ -52,16 +52,16 @@ def package_exports(attribute: str) -> List[str]:
     try:
         result = subprocess.run(command, capture_output=True, text=True, timeout=_ROSPACK_TIMEOUT_SECONDS)
     except FileNotFoundError:
-        warn_once(_log, "rospack is not installed (Debian package rospack-tools): the %s that packages export "
-                        "in package.xml are not searched" % attribute)
+        warn_once(_log, f"rospack is not installed (Debian package rospack-tools): the {attribute} that packages "
+                        "export in package.xml are not searched")
         return []
     except subprocess.TimeoutExpired:
-        warn_once(_log, "'%s' took more than %.0f s: the %s exports are not searched"
-                  % (" ".join(command), _ROSPACK_TIMEOUT_SECONDS, attribute))
+        warn_once(_log, f"'{' '.join(command)}' took more than {_ROSPACK_TIMEOUT_SECONDS:.0f} s: the {attribute} "
+                        "exports are not searched")
         return []
     if result.returncode != 0:
         # No gazebo_ros on ROS_PACKAGE_PATH (a plain pytest run, an unsourced shell): nothing can export to it.
-        _log.debug("%s: %s", " ".join(command), result.stderr.strip())
+        _log.debug(f"{' '.join(command)}: {result.stderr.strip()}")
         return []
     directories = []
     for line in result.stdout.splitlines():

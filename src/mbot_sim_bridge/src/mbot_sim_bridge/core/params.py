@@ -98,7 +98,7 @@ class PluginParams:
         if param.choices is not None and value not in param.choices:
             raise ConfigError(f"{self._prefix}: <{param.tag}> is '{value}'; expected one of "
                               f"{', '.join(param.choices)}")
-        _logger.debug("%s: <%s> = %s", self.label, param.tag, value)
+        _logger.debug(f"{self.label}: <{param.tag}> = {value}")
         return value
 
 

@@ -125,10 +125,10 @@ class RobotModel:
 
 def _parse_document(urdf_xml: str, source: str) -> XmlDocument:
     if not urdf_xml or not urdf_xml.strip():
-        raise ModelError("%s is empty" % source)
+        raise ModelError(f"{source} is empty")
     document = parse_xml(urdf_xml.encode(), source, ModelError)
     if document.root.tag != "robot":
-        raise ModelError("%s is not URDF: its root element is <%s>, not <robot>" % (source, document.root.tag))
+        raise ModelError(f"{source} is not URDF: its root element is <{document.root.tag}>, not <robot>")
     return document
 
 
@@ -154,9 +154,9 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     for element in root.findall("link"):
         link_name = element.get("name")
         if not link_name:
-            raise ModelError("%s: a <link> has no name" % source)
+            raise ModelError(f"{source}: a <link> has no name")
         if link_name in links:
-            raise ModelError("%s: link '%s' is defined twice" % (source, link_name))
+            raise ModelError(f"{source}: link '{link_name}' is defined twice")
         inertial = element.find("inertial")
         mass = 0.0
         if inertial is not None and inertial.find("mass") is not None:
@@ -164,35 +164,35 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
             try:
                 check_range(mass, 0.0, _MAX_MASS)
             except ValueError as error:
-                raise ModelError("%s: link '%s': <mass value>: %s" % (source, link_name, error)) from None
+                raise ModelError(f"{source}: link '{link_name}': <mass value>: {error}") from None
         kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
                  if geometry is not None and len(geometry)]
         links[link_name] = Link(link_name, inertial is not None and mass > 0, mass, kinds)
     if not links:
-        raise ModelError("%s: the robot has no <link>" % source)
+        raise ModelError(f"{source}: the robot has no <link>")
 
     joints: Dict[str, Joint] = {}
     for element in root.findall("joint"):
         joint_name = element.get("name")
         if not joint_name:
-            raise ModelError("%s: a <joint> has no name" % source)
-        where = "%s joint '%s'" % (source, joint_name)
+            raise ModelError(f"{source}: a <joint> has no name")
+        where = f"{source} joint '{joint_name}'"
         if joint_name in joints:
-            raise ModelError("%s: defined twice" % where)
+            raise ModelError(f"{where}: defined twice")
         joint_type = element.get("type")
         if joint_type not in SUPPORTED_JOINT_TYPES:
-            raise ModelError("%s: type '%s' is not supported; use one of %s"
-                             % (where, joint_type, ", ".join(SUPPORTED_JOINT_TYPES)))
+            raise ModelError(f"{where}: type '{joint_type}' is not supported; use one of "
+                             f"{', '.join(SUPPORTED_JOINT_TYPES)}")
         parent, child = element.find("parent"), element.find("child")
         if parent is None or child is None:
-            raise ModelError("%s: needs <parent link> and <child link>" % where)
+            raise ModelError(f"{where}: needs <parent link> and <child link>")
         for role, link_name in (("parent", parent.get("link")), ("child", child.get("link"))):
             if link_name not in links:
-                raise ModelError("%s: %s link '%s' is not defined" % (where, role, link_name))
+                raise ModelError(f"{where}: {role} link '{link_name}' is not defined")
         # URDF allows one parent; PyBullet would keep one of two silently (and crash on a duplicate joint).
         other = next((j.name for j in joints.values() if j.child == child.get("link")), None)
         if other is not None:
-            raise ModelError("%s: child link '%s' already has a parent joint, '%s'" % (where, child.get("link"), other))
+            raise ModelError(f"{where}: child link '{child.get('link')}' already has a parent joint, '{other}'")
         axis = element.find("axis")
         joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
                                    read_origin(element, document),
@@ -203,11 +203,11 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     children = {joint.child for joint in joints.values()}
     roots = [link_name for link_name in links if link_name not in children]
     if len(roots) != 1:
-        raise ModelError("%s: expected one root link, found %s" % (source, ", ".join(roots) or "none (a loop)"))
+        raise ModelError(f"{source}: expected one root link, found {', '.join(roots) or 'none (a loop)'}")
     unreachable = set(links) - set(_subtree(roots[0], joints))
     if unreachable:
-        raise ModelError("%s: links %s form a loop, not reachable from root link '%s'"
-                         % (source, ", ".join(sorted(unreachable)), roots[0]))
+        raise ModelError(f"{source}: links {', '.join(sorted(unreachable))} form a loop, not reachable "
+                         f"from root link '{roots[0]}'")
 
     plugins = _collect_gazebo_blocks(root, links, joints, source)
     transmissions = root.findall("transmission")
@@ -226,32 +226,31 @@ def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Elem
                 if child.tag == "plugin":
                     plugins.append(child)
                 elif child.tag != "static":
-                    warn_once(_logger, "%s: model-level <gazebo> tag <%s> is not supported; ignored"
-                              % (source, child.tag))
+                    warn_once(_logger, f"{source}: model-level <gazebo> tag <{child.tag}> is not supported; ignored")
             continue
         if reference in links:
             links[reference].gazebo.append(block)
             for child in block:
                 _check_link_tag(child, reference, source)
         elif reference not in joints:
-            warn_once(_logger, "%s: <gazebo reference='%s'> names no link or joint; ignored" % (source, reference))
+            warn_once(_logger, f"{source}: <gazebo reference='{reference}'> names no link or joint; ignored")
     return plugins
 
 
 def _check_link_tag(child: ElementTree.Element, reference: str, source: str):
     """Say once per tag and model what a <gazebo reference> tag that the bridge does not act on means."""
-    where = "%s: <gazebo reference='%s'> <%s>" % (source, reference, child.tag)
+    where = f"{source}: <gazebo reference='{reference}'> <{child.tag}>"
     if child.tag in LINK_TAGS_USED:
         return
     if child.tag in LINK_TAGS_DEFAULT_ONLY:
         if (child.text or "").strip().lower() not in (LINK_TAGS_DEFAULT_ONLY[child.tag],
                                                       "0" if LINK_TAGS_DEFAULT_ONLY[child.tag] == "false" else "1"):
-            warn_once(_logger, "%s%s</%s> is not simulated; Gazebo's default applies"
-                      % (where, (child.text or "").strip(), child.tag))
+            warn_once(_logger, f"{where}{(child.text or '').strip()}</{child.tag}> is not simulated; "
+                               "Gazebo's default applies")
     elif child.tag in LINK_TAGS_NO_EFFECT:
-        warn_once(_logger, "%s has no Bullet counterpart; ignored" % where)
+        warn_once(_logger, f"{where} has no Bullet counterpart; ignored")
     else:
-        warn_once(_logger, "%s is not supported; ignored" % where)
+        warn_once(_logger, f"{where} is not supported; ignored")
 
 
 def _subtree(link_name, joints) -> List[str]:
@@ -274,8 +273,8 @@ def _drop_massless_moving_links(links, joints, source) -> List[str]:
         if joint.name not in joints or not joint.movable or links[joint.child].has_inertial:
             continue
         subtree = _subtree(joint.child, joints)
-        warn_once(_logger, "%s: link '%s' has no <inertial> but moves on joint '%s'; like Gazebo, the simulation "
-                  "leaves out it and its subtree (%s)" % (source, joint.child, joint.name, ", ".join(subtree)))
+        warn_once(_logger, f"{source}: link '{joint.child}' has no <inertial> but moves on joint '{joint.name}'; like "
+                           f"Gazebo, the simulation leaves out it and its subtree ({', '.join(subtree)})")
         dropped.extend(subtree)
         for name in subtree:
             del links[name]
@@ -325,16 +324,16 @@ def _shape_problem(element: ElementTree.Element) -> Optional[str]:
     geometry = element.find("geometry")
     shapes = [] if geometry is None else list(geometry)
     if len(shapes) != 1:
-        return "<geometry> needs one shape (box, cylinder, sphere or mesh), found %s" % (
-            ", ".join("<%s>" % shape.tag for shape in shapes) or "none")
+        found = ", ".join(f"<{shape.tag}>" for shape in shapes) or "none"
+        return f"<geometry> needs one shape (box, cylinder, sphere or mesh), found {found}"
     shape = shapes[0]
     if shape.tag == "mesh":
         problem = _mesh_problem(shape.get("filename", ""))
         if problem is not None:
-            return "mesh '%s': %s" % (shape.get("filename", ""), problem)
+            return f"mesh '{shape.get('filename', '')}': {problem}"
         return _numbers_problem(shape, "scale", 3, optional=True, minimum=None)
     if shape.tag not in _SHAPE_SIZES:
-        return "<%s> is not a URDF shape (box, cylinder, sphere or mesh)" % shape.tag
+        return f"<{shape.tag}> is not a URDF shape (box, cylinder, sphere or mesh)"
     for attribute, count in _SHAPE_SIZES[shape.tag]:
         problem = _numbers_problem(shape, attribute, count, optional=False, minimum=0.0)
         if problem is not None:
@@ -346,13 +345,13 @@ def _numbers_problem(shape: ElementTree.Element, attribute: str, count: int, opt
                      minimum: Optional[float]) -> Optional[str]:
     text = shape.get(attribute)
     if text is None:
-        return None if optional else "<%s> needs %s" % (shape.tag, attribute)
+        return None if optional else f"<{shape.tag}> needs {attribute}"
     try:
         for value in parse_floats(text, count):
             check_range(abs(value) if minimum is None else value, minimum or 0.0, _MAX_SHAPE_SIZE,
                         exclusive_minimum=True)
     except ValueError as error:
-        return "<%s %s>: %s" % (shape.tag, attribute, error)
+        return f"<{shape.tag} {attribute}>: {error}"
     return None
 
 
@@ -361,14 +360,14 @@ def _check_links(root: ElementTree.Element, copied: ElementTree.Element, documen
     model; a bad visual is left out of ``copied`` (the URDF PyBullet gets) with a warning: the simulation does
     not need it, and PyBullet would refuse the whole URDF for it."""
     for link, copied_link in zip(root.findall("link"), copied.findall("link")):
-        _check_inertial(link.find("inertial"), document, "%s: link '%s'" % (source, link.get("name")))
+        _check_inertial(link.find("inertial"), document, f"{source}: link '{link.get('name')}'")
         for kind in ("collision", "visual"):
             for element, copied_element in zip(link.findall(kind), copied_link.findall(kind)):
                 read_origin(element, document)
                 problem = _shape_problem(element)
                 if problem is None:
                     continue
-                message = "%s: link '%s' %s %s" % (source, link.get("name"), kind, problem)
+                message = f"{source}: link '{link.get('name')}' {kind} {problem}"
                 if kind == "collision":
                     raise ModelError(message)
                 warn_once(_logger, message + "; the visual is left out")
@@ -387,7 +386,7 @@ def _check_inertial(inertial: Optional[ElementTree.Element], document: XmlDocume
         try:
             check_range(value if name in ("ixx", "iyy", "izz") else abs(value), 0.0, _MAX_INERTIA)
         except ValueError as error:
-            raise ModelError("%s: <inertia %s>: %s" % (where, name, error)) from None
+            raise ModelError(f"{where}: <inertia {name}>: {error}") from None
 
 
 def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], document: XmlDocument,

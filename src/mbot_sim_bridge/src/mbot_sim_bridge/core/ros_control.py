@@ -72,20 +72,19 @@ def parse_transmissions(root: ElementTree.Element, where: Callable[[ElementTree.
                 try:
                     value = float((reduction.text or "").strip())
                 except ValueError:
-                    raise ConfigError("%s: transmission '%s': <mechanicalReduction> '%s' is not a number"
-                                      % (where(reduction), name, (reduction.text or "").strip())) from None
+                    raise ConfigError(f"{where(reduction)}: transmission '{name}': <mechanicalReduction> "
+                                      f"'{(reduction.text or '').strip()}' is not a number") from None
             actuators.append((actuator.get("name"), _interfaces(actuator), value))
         problem = ("has no name" if not name else "has no <type>" if not kind
                    else "has no <joint>" if not joints or not all(joint for joint, _ in joints)
                    else "has no <actuator>" if not actuators else None)
         if problem:
-            _logger.error("%s: transmission '%s' %s; skipped, as transmission_interface's parser does",
-                          where(element), name, problem)
+            _logger.error(f"{where(element)}: transmission '{name}' {problem}; skipped, as "
+                          "transmission_interface's parser does")
             continue
         if kind != SIMPLE_TRANSMISSION:
-            warn_once(_logger, "%s: transmission '%s' has type '%s'; the default robot hardware simulation uses "
-                      "only its joint and hardware interface, as gazebo_ros_control does"
-                      % (where(element), name, kind))
+            warn_once(_logger, f"{where(element)}: transmission '{name}' has type '{kind}'; the default robot hardware "
+                               "simulation uses only its joint and hardware interface, as gazebo_ros_control does")
         transmissions.append(Transmission(name, kind, joints, actuators))
     return transmissions
 
@@ -175,7 +174,7 @@ def apply_limit_params(limits: Optional[JointLimits], params: Optional[dict], jo
     if not params:
         return limits
     if not isinstance(params, dict):
-        warn_once(_logger, "joint_limits/%s is not a dictionary; ignored" % joint)
+        warn_once(_logger, f"joint_limits/{joint} is not a dictionary; ignored")
         return limits
     limits = limits or JointLimits()
     for flag, values in _LIMIT_PAIRS:
@@ -228,7 +227,7 @@ class Pid:
         """Pid::init(nh): None (with upstream's error unless quiet) when there is no ``p``."""
         if not isinstance(params, dict) or "p" not in params:
             if not quiet:
-                _logger.error("No p gain specified for pid.  Namespace: %s", namespace)
+                _logger.error(f"No p gain specified for pid.  Namespace: {namespace}")
             return None
         i_clamp = abs(float(params.get("i_clamp", 0.0)))
         i_max, i_min = i_clamp, -i_clamp
@@ -237,8 +236,8 @@ class Pid:
         if "i_clamp_max" in params:
             i_max = abs(float(params["i_clamp_max"]))
         if params.get("publish_state"):
-            warn_once(_logger, "%s/publish_state: the PID state topic needs control_msgs, which Debian does not "
-                      "package; not published" % namespace)
+            warn_once(_logger, f"{namespace}/publish_state: the PID state topic needs control_msgs, which Debian does "
+                               "not package; not published")
         return cls(float(params["p"]), float(params.get("i", 0.0)), float(params.get("d", 0.0)), i_max, i_min,
                    bool(params.get("antiwindup", False)))
 
@@ -316,39 +315,39 @@ class RobotHWSim:
         limit_params, pid_params = limit_params or {}, pid_params or {}
         for transmission in transmissions:
             if len(transmission.joints) > 1:
-                _logger.warning("%s: Transmission %s has more than one joint. Currently the default robot hardware "
-                                "simulation  interface only supports one.", label, transmission.name)
+                _logger.warning(f"{label}: Transmission {transmission.name} has more than one joint. Currently the "
+                                "default robot hardware simulation  interface only supports one.")
                 continue
             joint_name, interfaces = transmission.joints[0]
             if not interfaces and transmission.actuators and transmission.actuators[0][1]:
                 interfaces = transmission.actuators[0][1]
-                warn_once(_logger, "%s: The <hardware_interface> element of tranmission %s should be nested inside the "
-                          "<joint> element, not <actuator>. The transmission will be properly loaded, but please "
-                          "update your robot model to remain compatible with future versions of the plugin."
-                          % (label, transmission.name))
+                warn_once(_logger, f"{label}: The <hardware_interface> element of tranmission {transmission.name} "
+                                   "should be nested inside the <joint> element, not <actuator>. The transmission "
+                                   "will be properly loaded, but please update your robot model to remain compatible "
+                                   "with future versions of the plugin.")
             if not interfaces:
-                _logger.warning("%s: Joint %s of transmission %s does not specify any hardware interface. Not adding "
-                                "it to the robot hardware simulation.", label, joint_name, transmission.name)
+                _logger.warning(f"{label}: Joint {joint_name} of transmission {transmission.name} does not specify any "
+                                "hardware interface. Not adding it to the robot hardware simulation.")
                 continue
             if len(interfaces) > 1:
-                _logger.warning("%s: Joint %s of transmission %s specifies multiple hardware interfaces. Currently "
-                                "the default robot hardware simulation interface only supports one. Using the "
-                                "first entry", label, joint_name, transmission.name)
+                _logger.warning(f"{label}: Joint {joint_name} of transmission {transmission.name} specifies multiple "
+                                "hardware interfaces. Currently the default robot hardware simulation interface only "
+                                "supports one. Using the first entry")
             interface = interfaces[0].replace("hardware_interface/", "", 1)
             if interface not in (EFFORT, POSITION, VELOCITY):
-                raise ConfigError("%s: No matching hardware interface found for '%s' while loading interfaces for %s"
-                                  % (label, interfaces[0], joint_name))
+                raise ConfigError(f"{label}: No matching hardware interface found for '{interfaces[0]}' while loading "
+                                  f"interfaces for {joint_name}")
             if interface == interfaces[0]:
-                warn_once(_logger, "%s: Deprecated syntax, please prepend 'hardware_interface/' to '%s' within the "
-                          "<hardwareInterface> tag in joint '%s'." % (label, interface, joint_name))
+                warn_once(_logger, f"{label}: Deprecated syntax, please prepend 'hardware_interface/' to '{interface}' "
+                                   f"within the <hardwareInterface> tag in joint '{joint_name}'.")
             if joint_name not in robot.joint_index:
-                raise ConfigError('%s: This robot has a joint named "%s" which is not in the gazebo model.'
-                                  % (label, joint_name))
+                raise ConfigError(f'{label}: This robot has a joint named "{joint_name}" which is '
+                                  'not in the gazebo model.')
             reductions = [value for _, _, value in transmission.actuators if value is not None and value != 1.0]
             if reductions:
-                info_once(_logger, "%s: transmission %s: mechanicalReduction %s is read but, as in "
-                          "gazebo_ros_control's default robot hardware simulation, not applied"
-                          % (label, transmission.name, reductions[0]))
+                info_once(_logger, f"{label}: transmission {transmission.name}: mechanicalReduction {reductions[0]} is "
+                                   "read but, as in gazebo_ros_control's default robot "
+                                   "hardware simulation, not applied")
             urdf_joint = urdf.joints.get(joint_name)
             limits = apply_limit_params(urdf_joint_limits(urdf_joint), limit_params.get(joint_name), joint_name)
             joint_type = urdf_joint.type if urdf_joint is not None else ""
@@ -356,18 +355,18 @@ class RobotHWSim:
                 joint_type = ("revolute" if limits.has_position_limits
                               else "continuous" if limits.angle_wraparound else "prismatic")
             if urdf_joint is not None and urdf_joint.has_safety_controller:
-                warn_once(_logger, "%s: joint '%s' has a <safety_controller>: soft joint limits are not simulated; "
-                          "its hard limits are enforced as saturation" % (label, joint_name))
+                warn_once(_logger, f"{label}: joint '{joint_name}' has a <safety_controller>: soft joint limits are "
+                                   "not simulated; its hard limits are enforced as saturation")
             self._check_limits(joint_name, interface, limits)
             pid = None
             if interface != EFFORT:
                 # Upstream logs "No p gain specified" as an error for every joint without gains; that is the
                 # normal case (the joint is driven directly), so it is said once at INFO here.
-                pid = Pid.from_params(pid_params.get(joint_name), "%s/%s" % (pid_namespace, joint_name), quiet=True)
+                pid = Pid.from_params(pid_params.get(joint_name), f"{pid_namespace}/{joint_name}", quiet=True)
                 if pid is None:
-                    info_once(_logger, "%s: no %s/%s/p: joint '%s' is driven directly (%s)"
-                              % (label, pid_namespace, joint_name, joint_name,
-                                 "position servo" if interface == POSITION else "velocity motor"))
+                    drive = "position servo" if interface == POSITION else "velocity motor"
+                    info_once(_logger, f"{label}: no {pid_namespace}/{joint_name}/p: joint '{joint_name}' is "
+                                       f"driven directly ({drive})")
             self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid)
         self.names = list(self.joints)
 
@@ -376,17 +375,17 @@ class RobotHWSim:
         if limits is None:
             return
         if interface in (EFFORT, VELOCITY) and not limits.has_velocity_limits:
-            raise ConfigError("%s: Cannot enforce limits for joint '%s'. It has no velocity limits specification."
-                              % (self.label, joint))
+            raise ConfigError(f"{self.label}: Cannot enforce limits for joint '{joint}'. It has no "
+                              "velocity limits specification.")
         if interface == EFFORT and not limits.has_effort_limits:
-            raise ConfigError("%s: Cannot enforce limits for joint '%s'. It has no efforts limits specification."
-                              % (self.label, joint))
+            raise ConfigError(f"{self.label}: Cannot enforce limits for joint '{joint}'. It has no "
+                              "efforts limits specification.")
 
     def handle(self, name: str, interface: str) -> SimJoint:
         """A command handle (interface EFFORT/POSITION/VELOCITY) or a state handle (JOINT_STATE)."""
         joint = self.joints.get(name)
         if joint is None or (interface != JOINT_STATE and joint.interface != interface):
-            raise HardwareInterfaceError("Could not find resource '%s' in '%s'." % (name, INTERFACE_TYPES[interface]))
+            raise HardwareInterfaceError(f"Could not find resource '{name}' in '{INTERFACE_TYPES[interface]}'.")
         return joint
 
     def names_with(self, interface: str) -> List[str]:
@@ -550,19 +549,19 @@ class ControllerManager:
     def load(self, name: str, urdf=None) -> bool:
         with self._lock:
             if self.find(name) is not None:
-                _logger.error("A controller named '%s' was already loaded inside the controller manager", name)
+                _logger.error(f"A controller named '{name}' was already loaded inside the controller manager")
                 return False
             params = self.get_params(name)
             controller_type = params.get("type") if isinstance(params, dict) else None
             if not isinstance(controller_type, str):
-                _logger.error("Could not load controller '%s' because the type was not specified. Did you load the "
-                              "controller configuration on the parameter server (namespace: '%s')?",
-                              name, _join(self.namespace, name))
+                _logger.error(f"Could not load controller '{name}' because the type was not specified. Did you load "
+                              "the controller configuration on the parameter server (namespace: "
+                              f"'{_join(self.namespace, name)}')?")
                 return False
             controller_class = self.factory(controller_type)
             if controller_class is None:
-                _logger.error("Could not load controller '%s' because controller type '%s' does not exist.",
-                              name, controller_type)
+                _logger.error(f"Could not load controller '{name}' because controller type "
+                              f"'{controller_type}' does not exist.")
                 _logger.error("Use 'rosservice call controller_manager/list_controller_types' to get the available "
                               "types")
                 return False
@@ -571,28 +570,28 @@ class ControllerManager:
                 controller = controller_class(name, self.hw, params, context)
             except ControllerInitError as error:
                 for line in str(error).splitlines():
-                    _logger.error("%s", line)
+                    _logger.error(line)
                 _logger.error("Failed to initialize the controller")
-                _logger.error("Initializing controller '%s' failed", name)
+                _logger.error(f"Initializing controller '{name}' failed")
                 return False
             except HardwareInterfaceError as error:
-                _logger.error("Exception thrown while initializing controller '%s'.\n%s", name, error)
-                _logger.error("Initializing controller '%s' failed", name)
+                _logger.error(f"Exception thrown while initializing controller '{name}'.\n{error}")
+                _logger.error(f"Initializing controller '{name}' failed")
                 return False
             claimed = [(INTERFACE_TYPES[controller.INTERFACE], list(controller.claimed))]
             self.controllers = self.controllers + [LoadedController(name, controller_type, controller, claimed)]
-            _logger.debug("Successfully load controller '%s'", name)
+            _logger.debug(f"Successfully load controller '{name}'")
             return True
 
     def unload(self, name: str) -> bool:
         with self._lock:
             loaded = self.find(name)
             if loaded is None:
-                _logger.error("Could not unload controller with name '%s' because no controller with this name "
-                              "exists", name)
+                _logger.error(f"Could not unload controller with name '{name}' because no "
+                              "controller with this name exists")
                 return False
             if loaded.state == "running":
-                _logger.error("Could not unload controller with name '%s' because it is still running", name)
+                _logger.error(f"Could not unload controller with name '{name}' because it is still running")
                 return False
             self.controllers = [other for other in self.controllers if other is not loaded]
             loaded.controller.close()
@@ -615,11 +614,11 @@ class ControllerManager:
                     loaded = self.find(name)
                     if loaded is None:
                         if strict:
-                            _logger.error("Could not %s controller with name '%s' because no controller with this "
-                                          "name exists", verb, name)
+                            _logger.error(f"Could not {verb} controller with name '{name}' because no "
+                                          "controller with this name exists")
                             return False
-                        _logger.debug("Could not %s controller with name '%s' because no controller with this name "
-                                      "exists", verb, name)
+                        _logger.debug(f"Could not {verb} controller with name '{name}' because no "
+                                      "controller with this name exists")
                     else:
                         target.append(loaded)
             active = []
@@ -628,19 +627,19 @@ class ControllerManager:
                 running = loaded.state == "running"
                 if not running and in_stop:
                     if strict:
-                        _logger.error("Could not stop controller '%s' since it is not running", loaded.name)
+                        _logger.error(f"Could not stop controller '{loaded.name}' since it is not running")
                         return False
                     in_stop = False
                     stop_list.remove(loaded)
                 if running and not in_stop and in_start:
                     if strict:
-                        _logger.error("Controller '%s' is already running", loaded.name)
+                        _logger.error(f"Controller '{loaded.name}' is already running")
                         return False
                     in_start = False
                     start_list.remove(loaded)
                 if in_stop and in_start:
-                    _logger.error("Could no start or stop controller '%s' because of conflicting switching command",
-                                  loaded.name)
+                    _logger.error(f"Could no start or stop controller '{loaded.name}' because of "
+                                  "conflicting switching command")
                     return False
                 if in_start or (running and not in_stop):
                     active.append(loaded)
@@ -667,8 +666,8 @@ class ControllerManager:
         conflict = False
         for resource, names in sorted(claims.items()):
             if len(names) > 1:
-                _logger.warning("Resource conflict on [%s].  Controllers = [%s]", resource,
-                                "".join(name + ", " for name in names))
+                listed = "".join(name + ", " for name in names)
+                _logger.warning(f"Resource conflict on [{resource}].  Controllers = [{listed}]")
                 conflict = True
         return conflict
 

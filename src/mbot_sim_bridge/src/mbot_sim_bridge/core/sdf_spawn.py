@@ -12,7 +12,7 @@ from .xml_values import parse_xml, read_pose
 
 
 def _pose_text(pose: Pose) -> str:
-    return " ".join("%.9g" % value for value in tuple(pose.position) + tuple(rpy(pose.orientation)))
+    return " ".join(f"{value:.9g}" for value in tuple(pose.position) + tuple(rpy(pose.orientation)))
 
 
 def _set_pose(element: ElementTree.Element, pose: Pose):
@@ -23,16 +23,15 @@ def _set_pose(element: ElementTree.Element, pose: Pose):
 
 
 def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
-    where = "model '%s'" % name
+    where = f"model '{name}'"
     document = parse_xml(model_xml.encode(), where, ModelError)
     root = document.root
     if root.tag != "sdf":
-        raise ModelError("%s is not SDF: its root element is <%s>, not <sdf>" % (where, root.tag))
+        raise ModelError(f"{where} is not SDF: its root element is <{root.tag}>, not <sdf>")
     world = root.find("world")
     entries = (world.findall("model") + world.findall("include")) if world is not None else root.findall("model")
     if len(entries) != 1:
-        raise ModelError("%s: expected exactly one <model> (or one <include> in a <world>), found %d"
-                         % (where, len(entries)))
+        raise ModelError(f"{where}: expected exactly one <model> (or one <include> in a <world>), found {len(entries)}")
     entry = entries[0]
     if entry.tag == "model":
         entry.set("name", name)

@@ -94,7 +94,7 @@ class Simulation:
         """Build the models of a world (the loaded one, or one spawn_sdf_model wraps); returns the names added."""
         duplicates = [model.name for model in description.models if model.name in self.model_names()]
         if duplicates:
-            raise ModelError("SpawnModel: Failure - entity already exists: %s" % ", ".join(duplicates))
+            raise ModelError(f"SpawnModel: Failure - entity already exists: {', '.join(duplicates)}")
         loaded = load_world(self.engine.client, description)
         self.engine.add_world(loaded)
         for model in description.models:
@@ -107,7 +107,7 @@ class Simulation:
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
         """Put a parsed robot in the engine with its plugins; on any error, leave nothing of it behind."""
         if len(model.links) > LARGE_MODEL_LINKS:
-            _logger.info("model '%s': %d links; PyBullet takes a while to load that many", name, len(model.links))
+            _logger.info(f"model '{name}': {len(model.links)} links; PyBullet takes a while to load that many")
         robot = self.engine.spawn_robot(model, name, pose, namespace, driven_joints=None)
         spawned = SpawnedModel(name, namespace, robot)
         try:
@@ -124,13 +124,13 @@ class Simulation:
         self._schedule()
         if self.viewer is not None:
             self.viewer.show_robot(robot)
-        _logger.info("spawned '%s' (%d links, %d movable joints, %d plugins) at %s", name, len(robot.link_index),
-                     len(robot.movable_joints), len(spawned.plugins), tuple(round(v, 3) for v in pose.position))
+        _logger.info(f"spawned '{name}' ({len(robot.link_index)} links, {len(robot.movable_joints)} movable joints, "
+                     f"{len(spawned.plugins)} plugins) at {tuple(round(v, 3) for v in pose.position)}")
         return spawned
 
     def delete(self, name: str):
         if name not in self.model_names():
-            raise ModelError("DeleteModel: model '%s' does not exist" % name)
+            raise ModelError(f"DeleteModel: model '{name}' does not exist")
         spawned = self.models.pop(name, None)
         if spawned is not None:
             for plugin in spawned.plugins:
@@ -158,8 +158,8 @@ class Simulation:
         for link_name, sensor in model.sensors():
             elements = sensor.findall("plugin")
             if not elements:
-                warn_once(_logger, "model '%s': sensor '%s' on link '%s' has no ROS plugin; nothing is published "
-                          "for it" % (spawned.name, sensor.get("name"), link_name))
+                warn_once(_logger, f"model '{spawned.name}': sensor '{sensor.get('name')}' on link '{link_name}' has "
+                                   "no ROS plugin; nothing is published for it")
             for element in elements:
                 plugins.extend(self._create_plugin(spawned, element, sensor, link_name))
         published = {joint for plugin in plugins for joint in plugin.joint_states_published}
@@ -174,20 +174,20 @@ class Simulation:
         plugin_class = self.registry.get(filename)
         where = spawned.robot.model.document.where(element)
         if plugin_class is None:
-            what = ("sensor '%s' (type %s) on link '%s': " % (sensor.get("name"), sensor.get("type"), link_name)
+            what = (f"sensor '{sensor.get('name')}' (type {sensor.get('type')}) on link '{link_name}': "
                     if sensor is not None else "")
-            warn_once(_logger, "%s: model '%s': %splugin '%s' (%s) is not emulated by the bridge; ignored"
-                      % (where, spawned.name, what, element.get("name"), filename))
+            warn_once(_logger, f"{where}: model '{spawned.name}': {what}plugin '{element.get('name')}' ({filename}) is "
+                               "not emulated by the bridge; ignored")
             return []
         if bool(plugin_class.SENSOR_TYPES) != (sensor is not None):
             kind = "a sensor plugin (it goes inside a <sensor>)" if plugin_class.SENSOR_TYPES else "a model plugin"
-            warn_once(_logger, "%s: model '%s': %s is %s; ignored here, as Gazebo would not load it"
-                      % (where, spawned.name, filename, kind))
+            warn_once(_logger, f"{where}: model '{spawned.name}': {filename} is {kind}; ignored here, as "
+                               "Gazebo would not load it")
             return []
         if sensor is not None and sensor.get("type") not in plugin_class.SENSOR_TYPES:
-            raise ConfigError("%s: model '%s': %s needs <sensor type=\"%s\">, but sensor '%s' has type \"%s\""
-                              % (where, spawned.name, filename, "\" or \"".join(plugin_class.SENSOR_TYPES),
-                                 sensor.get("name"), sensor.get("type")))
+            wanted = '" or "'.join(plugin_class.SENSOR_TYPES)
+            raise ConfigError(f"{where}: model '{spawned.name}': {filename} needs <sensor type=\"{wanted}\">, but "
+                              f"sensor '{sensor.get('name')}' has type \"{sensor.get('type')}\"")
         context = PluginContext(self, spawned, link_name)
         return [plugin_class(context, element, sensor)]
 
@@ -238,14 +238,14 @@ class Simulation:
         try:
             method(argument)
         except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
-            _logger.error("model '%s': plugin %s failed and is disabled: %s: %s", plugin.context.model.name,
-                          plugin.label, type(error).__name__, error)
-            _logger.debug("the failure of %s", plugin.label, exc_info=True)
+            _logger.error(f"model '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
+                          f"{type(error).__name__}: {error}")
+            _logger.debug(f"the failure of {plugin.label}", exc_info=True)
             plugin.context.model.plugins.remove(plugin)
             try:
                 plugin.close()
             except Exception:  # closing a broken plugin may fail too; it is gone either way
-                _logger.debug("closing %s failed", plugin.label, exc_info=True)
+                _logger.debug(f"closing {plugin.label} failed", exc_info=True)
             self._schedule()
 
     # -- reset ---------------------------------------------------------------------------------------------------

@@ -61,7 +61,7 @@ def load_world(client, description: WorldDescription) -> LoadedWorld:
         collision_shapes = [(shape, _collision_shape(client, shape, model.static, frame)) for shape in model.shapes]
         collision_shapes = [(shape, index) for shape, index in collision_shapes if index is not None]
         if not collision_shapes:
-            _log.debug("model '%s' has no collision shape; no body created", model.name)
+            _log.debug(f"model '{model.name}' has no collision shape; no body created")
             continue
         if single:
             body = client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shapes[0][1],

@@ -67,7 +67,7 @@ def pose_text(pose: Pose) -> str:
 
 
 def _number(value: float) -> str:
-    text = "%.9g" % value
+    text = f"{value:.9g}"
     return "0" if text == "-0" else text
 
 
@@ -276,7 +276,7 @@ def write_world_file(path: str, text: str):
     directory = os.path.dirname(path)
     temporary = None
     try:
-        handle, temporary = tempfile.mkstemp(prefix=".%s." % os.path.basename(path), suffix=".tmp", dir=directory)
+        handle, temporary = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=".tmp", dir=directory)
         with os.fdopen(handle, "w") as output:
             output.write(text)
         os.chmod(temporary, 0o644)

@@ -50,7 +50,7 @@ def resolve_frame(frame: str, prefix: str = "") -> str:
     if frame.startswith("/"):
         return frame.lstrip("/")
     prefix = prefix.strip("/")
-    return "%s/%s" % (prefix, frame) if prefix else frame
+    return f"{prefix}/{frame}" if prefix else frame
 
 
 def sensor_namespace(plugin) -> str:

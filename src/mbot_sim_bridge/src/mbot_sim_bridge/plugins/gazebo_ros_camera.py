@@ -44,10 +44,10 @@ class GazeboRosCamera(Camera):
                                              CameraInfo)
         self.info = camera_info_message(self.intrinsics, self.frame_id)
         config = self.config
-        rospy.loginfo("%s: sensor '%s' on link '%s' -> %s, %s (frame '%s'), %dx%d %s at %g Hz (%s renderer)",
-                      self.label, config.sensor_name, config.link, self.image_publisher.resolved_name,
-                      self.info_publisher.resolved_name, self.frame_id, config.width, config.height, self.encoding,
-                      self.frame_rate, self.renderer.renderer)
+        rospy.loginfo(f"{self.label}: sensor '{config.sensor_name}' on link '{config.link}' -> "
+                      f"{self.image_publisher.resolved_name}, {self.info_publisher.resolved_name} (frame "
+                      f"'{self.frame_id}'), {config.width}x{config.height} {self.encoding} at {self.frame_rate:g} Hz "
+                      f"({self.renderer.renderer} renderer)")
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor renders only while the image or camera_info has a subscriber.

@@ -41,10 +41,9 @@ class GazeboRosControl(RosControl):
                     ("reload_controller_libraries", ReloadControllerLibraries, self._reload_libraries))
         self.services = [rospy.Service(prefix + name, service_type, self._serialized(handler))
                          for name, service_type, handler in handlers]
-        rospy.loginfo("%s: controller manager in namespace %s: %d joints (%s), control period %.4f s",
-                      self.label, self.namespace, len(self.hw.joints),
-                      ", ".join("%s: %s" % (name, joint.interface) for name, joint in self.hw.joints.items()),
-                      self.control_period)
+        joints = ", ".join(f"{name}: {joint.interface}" for name, joint in self.hw.joints.items())
+        rospy.loginfo(f"{self.label}: controller manager in namespace {self.namespace}: {len(self.hw.joints)} joints "
+                      f"({joints}), control period {self.control_period:.4f} s")
 
     # -- hooks -------------------------------------------------------------------------------------------
     def robot_description(self, param_name):
@@ -56,9 +55,9 @@ class GazeboRosControl(RosControl):
             if param_name.startswith("/"):
                 name = param_name
             if rospy.has_param(name):
-                return rospy.get_param(name), "parameter %s" % name
-        rospy.logwarn("%s: no parameter '%s' from namespace %s upwards (gazebo_ros_control would wait for it); "
-                      "using the description the model was spawned from", self.label, param_name, self.namespace)
+                return rospy.get_param(name), f"parameter {name}"
+        rospy.logwarn(f"{self.label}: no parameter '{param_name}' from namespace {self.namespace} upwards "
+                      "(gazebo_ros_control would wait for it); using the description the model was spawned from")
         return None, ""
 
     def ros_param(self, name):
@@ -124,8 +123,8 @@ class GazeboRosControl(RosControl):
     def _reload_libraries(self, request):
         names = [loaded.name for loaded in self.manager.list()]
         if names and not request.force_kill:
-            rospy.logerr("Controller manager: Cannot reload controller libraries because there are still %i "
-                         "controllers running", len(names))
+            rospy.logerr("Controller manager: Cannot reload controller libraries because there are still "
+                         f"{len(names)} controllers running")
             return ReloadControllerLibrariesResponse(False)
         if names:
             rospy.loginfo("Controller manager: Killing all running controllers")
@@ -135,8 +134,8 @@ class GazeboRosControl(RosControl):
                 return ReloadControllerLibrariesResponse(False)
             for name in names:
                 if not self.manager.unload(name):
-                    rospy.logerr("Controller manager: Cannot reload controller libraries because failed to unload "
-                                 "controller '%s'", name)
+                    rospy.logerr("Controller manager: Cannot reload controller libraries because failed to "
+                                 f"unload controller '{name}'")
                     return ReloadControllerLibrariesResponse(False)
         rospy.loginfo("Controller manager: reloaded controller libraries for 'controller_interface'")
         return ReloadControllerLibrariesResponse(True)

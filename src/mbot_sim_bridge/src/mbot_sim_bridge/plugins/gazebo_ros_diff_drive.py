@@ -28,22 +28,21 @@ class GazeboRosDiffDrive(DiffDrive):
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
         self.subscriber = TrackedSubscriber(self.command_topic, Twist, self._on_command)
         if params["publishWheelTF"]:
-            rospy.loginfo("%s: publishWheelTF: the wheel frames reach /tf through robot_state_publisher from "
-                          "joint_states; they are not broadcast a second time (that duplicate is what makes "
-                          "Gazebo's wheels jump in rviz, gazebo_ros_pkgs#1524)", self.label)
-        rospy.loginfo("%s: %s -> wheels %s/%s, separation %.3f m, diameter %.3f m, torque %.1f N·m, "
-                      "acceleration %.2f m/s², %s odometry on %s at %.0f Hz, legacyMode %s",
-                      self.label, self.command_topic, self.joints[0], self.joints[1],
-                      self.geometry.wheel_separation, 2 * self.geometry.wheel_radius, self.torque,
-                      self.ramp.acceleration, params["odometrySource"],
-                      self.odom_publisher.resolved_name if self.odom_publisher else "(none: publishTf false)",
-                      params["updateRate"], self.geometry.legacy_mode)
+            rospy.loginfo(f"{self.label}: publishWheelTF: the wheel frames reach /tf through robot_state_publisher "
+                          "from joint_states; they are not broadcast a second time (that duplicate is what makes "
+                          "Gazebo's wheels jump in rviz, gazebo_ros_pkgs#1524)")
+        odometry = self.odom_publisher.resolved_name if self.odom_publisher else "(none: publishTf false)"
+        rospy.loginfo(f"{self.label}: {self.command_topic} -> wheels {self.joints[0]}/{self.joints[1]}, separation "
+                      f"{self.geometry.wheel_separation:.3f} m, diameter {2 * self.geometry.wheel_radius:.3f} m, "
+                      f"torque {self.torque:.1f} N·m, acceleration {self.ramp.acceleration:.2f} m/s², "
+                      f"{params['odometrySource']} odometry on {odometry} at {params['updateRate']:.0f} Hz, legacyMode "
+                      f"{self.geometry.legacy_mode}")
 
     def _on_command(self, message: Twist):
         linear, angular = message.linear.x, message.angular.z
         if not self.set_command(linear, angular):
-            rospy.logwarn_throttle(5.0, "%s: ignored a %s with a non-finite value (linear.x %s, angular.z %s); "
-                                   "keeping the last valid command" % (self.label, self.command_topic, linear, angular))
+            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a non-finite value "
+                                        f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
 
     def update(self, now: float):
         # Topics nobody listens to are skipped: the loop publishes synchronously, so each costs real time.

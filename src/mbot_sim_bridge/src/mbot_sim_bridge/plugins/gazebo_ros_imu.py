@@ -31,10 +31,9 @@ class GazeboRosImu(ImuModelPlugin):
             self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
             self.service = rospy.Service(resolve_in_namespace(namespace, self.params["serviceName"]), Empty,
                                          lambda request: EmptyResponse())
-        rospy.loginfo("%s: link '%s' -> %s (frame '%s') %s", self.label, self.link,
-                      self.publisher.resolved_name if self.publisher else "(no topicName: nothing)",
-                      self.frame_name, "at every physics step" if not self.params["updateRate"]
-                      else "at %g Hz" % self.params["updateRate"])
+        topic = self.publisher.resolved_name if self.publisher else "(no topicName: nothing)"
+        rate = f"at {self.params['updateRate']:g} Hz" if self.params["updateRate"] else "at every physics step"
+        rospy.loginfo(f"{self.label}: link '{self.link}' -> {topic} (frame '{self.frame_name}') {rate}")
 
     def update(self, now: float):
         listened = self.publisher is not None and self.publisher.get_num_connections() > 0

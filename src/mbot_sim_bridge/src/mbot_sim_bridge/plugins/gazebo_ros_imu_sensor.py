@@ -14,9 +14,9 @@ class GazeboRosImuSensor(ImuSensor):
         namespace = self.params["robotNamespace"]
         namespace = "/" + context.model.name if namespace is None else (namespace or "/")
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
-        rospy.loginfo("%s: sensor '%s' on link '%s' -> %s (frame '%s') at %s", self.label, sensor.get("name"),
-                      self.link, self.publisher.resolved_name, self.params["frameName"],
-                      "every physics step" if self.timer.period == 0 else "%g Hz" % (1.0 / self.timer.period))
+        rate = "every physics step" if self.timer.period == 0 else f"{1.0 / self.timer.period:g} Hz"
+        rospy.loginfo(f"{self.label}: sensor '{sensor.get('name')}' on link '{self.link}' -> "
+                      f"{self.publisher.resolved_name} (frame '{self.params['frameName']}') at {rate}")
 
     def update(self, now: float):
         if self.publisher.get_num_connections() == 0:

@@ -17,9 +17,10 @@ class GazeboRosLaser(RaySensor):
         self.message.angle_min, self.message.angle_max = config.min_angle, config.max_angle
         self.message.angle_increment = config.angle_increment
         self.message.range_min, self.message.range_max = config.range_min, config.range_max
-        rospy.loginfo("%s: sensor '%s' on link '%s' -> %s (frame %s), %d ranges at %.1f Hz", self.label,
-                      config.sensor_name, config.link, self.publisher.resolved_name, self.message.header.frame_id,
-                      config.range_count * config.vertical_range_count, config.update_rate)
+        ranges = config.range_count * config.vertical_range_count
+        rospy.loginfo(f"{self.label}: sensor '{config.sensor_name}' on link '{config.link}' -> "
+                      f"{self.publisher.resolved_name} (frame {self.message.header.frame_id}), {ranges} ranges at "
+                      f"{config.update_rate:.1f} Hz")
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor works only while someone listens.

@@ -34,15 +34,15 @@ class GazeboRosOpenniKinect(DepthCamera):
         self.cloud.point_step = POINT_STEP
         self.cloud.row_step = POINT_STEP * self.config.width
         config = self.config
-        rospy.loginfo("%s: sensor '%s' on link '%s' -> %s, %s, %s (frame '%s'), %dx%d at %g Hz, camera_info at "
-                      "%s, cloud within (%g, %g) m (%s renderer)", self.label, config.sensor_name, config.link,
-                      self.image_publisher.resolved_name, self.depth_publisher.resolved_name,
-                      self.cloud_publisher.resolved_name, self.frame_id, config.width, config.height,
-                      self.frame_rate, "%g Hz" % params["updateRate"] if params["updateRate"] else "every frame",
-                      self.cutoff, self.cutoff_max, self.renderer.renderer)
+        info_rate = f"{params['updateRate']:g} Hz" if params["updateRate"] else "every frame"
+        rospy.loginfo(f"{self.label}: sensor '{config.sensor_name}' on link '{config.link}' -> "
+                      f"{self.image_publisher.resolved_name}, {self.depth_publisher.resolved_name}, "
+                      f"{self.cloud_publisher.resolved_name} (frame '{self.frame_id}'), {config.width}x{config.height} "
+                      f"at {self.frame_rate:g} Hz, camera_info at {info_rate}, cloud within ({self.cutoff:g}, "
+                      f"{self.cutoff_max:g}) m ({self.renderer.renderer} renderer)")
         if isinstance(self, PlainDepthCamera):
-            rospy.loginfo("%s: the reflectance and normals topics of libgazebo_ros_depth_camera.so are not "
-                          "published", self.label)
+            rospy.loginfo(f"{self.label}: the reflectance and normals topics of "
+                          "libgazebo_ros_depth_camera.so are not published")
 
     def update(self, now: float):
         image_wanted = self.image_publisher.get_num_connections() > 0

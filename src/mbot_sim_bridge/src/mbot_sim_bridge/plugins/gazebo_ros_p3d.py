@@ -11,9 +11,9 @@ class GazeboRosP3D(P3D):
         super().__init__(context, element, sensor)
         namespace = self.params["robotNamespace"] or "/"
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Odometry)
-        rospy.loginfo("%s: link '%s' -> %s in frame '%s' %s", self.label, self.body, self.publisher.resolved_name,
-                      self.frame_name, "at every physics step" if not self.params["updateRate"]
-                      else "at %g Hz" % self.params["updateRate"])
+        rate = f"at {self.params['updateRate']:g} Hz" if self.params["updateRate"] else "at every physics step"
+        rospy.loginfo(f"{self.label}: link '{self.body}' -> {self.publisher.resolved_name} in frame "
+                      f"'{self.frame_name}' {rate}")
 
     def update(self, now: float):
         listened = self.publisher.get_num_connections() > 0

@@ -60,7 +60,7 @@ class RosDiffDriveController(DiffDriveController):
         complaint = self.set_command(message.linear.x, message.angular.z, self.clock(),
                                      self.subscriber.get_num_connections())
         if complaint:
-            rospy.logerr_throttle(1.0, "%s: %s" % (self.name, complaint))
+            rospy.logerr_throttle(1.0, f"{self.name}: {complaint}")
 
     def update(self, now, period):
         super().update(now, period)
@@ -113,8 +113,8 @@ class _CommandTopic:
 
     def _subscribe(self, namespace, group):
         if hasattr(self, "pid"):
-            warn_once(_logger, "%s: the 'state' topic (control_msgs/JointControllerState) is not published: Debian "
-                      "does not package control_msgs" % self.name)
+            warn_once(_logger, f"{self.name}: the 'state' topic (control_msgs/JointControllerState) is not published: "
+                               "Debian does not package control_msgs")
         message_type = Float64MultiArray if group else Float64
         self.subscriber = TrackedSubscriber(namespace + "/command", message_type, self._on_command)
 
