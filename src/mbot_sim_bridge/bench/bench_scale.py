@@ -60,9 +60,9 @@ def box_world(path: str):
     side = int(BOXES ** 0.5) + 1
     for index in range(BOXES):
         x, y = 0.5 * (index % side), 0.5 * (index // side)
-        rows.append(f"<model name='box_{index}'><static>true</static><pose>{x:g} {y:g} 0.1 0 0 0</pose><link "
-                    "name='l'><collision name='c'><geometry><box><size>0.2 0.2 "
-                    "0.2</size></box></geometry></collision></link></model>")
+        rows.append(f"<model name='box_{index}'><static>true</static><pose>{x:g} {y:g} 0.1 0 0 0</pose>"
+                    "<link name='l'><collision name='c'><geometry><box><size>0.2 0.2 0.2</size></box></geometry>"
+                    "</collision></link></model>")
     rows.append("</world></sdf>")
     with open(path, "w") as stream:
         stream.write("\n".join(rows))

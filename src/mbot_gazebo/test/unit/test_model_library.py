@@ -23,11 +23,11 @@ def write_model(directory, name, description="A test model.", title=None):
     model = directory / name
     model.mkdir(parents=True)
     (model / "model.config").write_text(
-        f"<model><name>{title or name}</name><sdf "
-        f"version='1.6'>model.sdf</sdf><description>{description}</description></model>")
+        f"<model><name>{title or name}</name><sdf version='1.6'>model.sdf</sdf>"
+        f"<description>{description}</description></model>")
     (model / "model.sdf").write_text(
-        f"<sdf version='1.6'><model name='{name}'><static>true</static><link name='l'><collision "
-        "name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link></model></sdf>")
+        f"<sdf version='1.6'><model name='{name}'><static>true</static><link name='l'><collision name='c'>"
+        "<geometry><box><size>1 1 1</size></box></geometry></collision></link></model></sdf>")
     return model
 
 

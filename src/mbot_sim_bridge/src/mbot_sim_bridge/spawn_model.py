@@ -61,8 +61,8 @@ def parse_arguments(argv):
 
 def read_model_xml(arguments) -> str:
     if arguments.database:
-        return ("<sdf version='1.6'><world "
-                f"name='default'><include><uri>model://{arguments.database}</uri></include></world></sdf>")
+        return (f"<sdf version='1.6'><world name='default'><include><uri>model://{arguments.database}</uri>"
+                "</include></world></sdf>")
     if arguments.file:
         try:
             with open(arguments.file) as model_file:
