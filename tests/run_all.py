@@ -9,6 +9,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 import time
 import xml.etree.ElementTree as ET
 
@@ -17,6 +18,8 @@ RESULTS = os.path.join(ROOT, "build", "test_results")
 # rostest files: each package's test/ folder and the workspace's tests/.
 ROSTEST_GLOBS = ("src/*/test/*.test", "tests/*.test")
 PYTEST_ROOTS = ("src/*/test", "tests")
+# The longest rostest file takes under a minute; one that hangs is stopped and counted as failed.
+ROSTEST_TIMEOUT_SECONDS = 600
 
 
 def rostest_nodes(test_files):
@@ -57,12 +60,22 @@ def run_pytest(selected, ignored):
 def run_rostest(test_file):
     print(f"== rostest {os.path.relpath(test_file, ROOT)}", flush=True)
     started = time.monotonic()
-    result = subprocess.run(["rostest", "--text", test_file], cwd=ROOT, capture_output=True, text=True)
-    output = result.stdout + result.stderr
+    # Output goes to a file, not a pipe: a node that outlived rostest would hold a pipe open, and reading it
+    # would wait for ever.
+    with tempfile.TemporaryFile("w+") as log:
+        try:
+            returncode = subprocess.run(["rostest", "--text", test_file], cwd=ROOT, stdout=log,
+                                        stderr=subprocess.STDOUT, timeout=ROSTEST_TIMEOUT_SECONDS).returncode
+        except subprocess.TimeoutExpired:
+            returncode = None
+        log.seek(0)
+        output = log.read()
+    if returncode is None:
+        output += f"\nrostest {test_file} did not finish within {ROSTEST_TIMEOUT_SECONDS} s; stopped"
     tests = re.findall(r"\* TESTS: (\d+)", output)
     errors = re.findall(r"\* ERRORS: (\d+)", output)
     failures = re.findall(r"\* FAILURES: (\d+)", output)
-    if result.returncode != 0 or not tests:
+    if returncode != 0 or not tests:
         print(output)
     else:
         # The test nodes print their measurements as "figure: ..." lines; show them, not the launch chatter.
@@ -70,7 +83,7 @@ def run_rostest(test_file):
             print("   " + figure)
     total = int(tests[-1]) if tests else 0
     failed = (int(errors[-1]) + int(failures[-1])) if tests else 1
-    if result.returncode != 0 and failed == 0:
+    if returncode != 0 and failed == 0:
         failed = 1
     print(f"   {total} tests, {failed} failed ({time.monotonic() - started:.0f} s)", flush=True)
     return total - min(failed, total), failed

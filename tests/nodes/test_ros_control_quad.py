@@ -21,6 +21,17 @@ from sim_support import WALL_TIMEOUT, wait_for, yaw_of
 CONTROLLER = "quad_velocity_controller"
 
 
+def interrupt(process: subprocess.Popen):
+    """Ctrl-C to a command started in a session of its own; one that does not exit fails the test and is killed."""
+    os.killpg(process.pid, signal.SIGINT)
+    try:
+        process.wait(WALL_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+        raise AssertionError(f"{' '.join(process.args)} did not exit within {WALL_TIMEOUT} s of SIGINT") from None
+
+
 class RosControlQuad(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -90,8 +101,7 @@ class RosControlQuad(unittest.TestCase):
             wait_for(lambda: self.states().get("extra_joint_publisher") == "initialized",
                      what="the spawner to load extra_joint_publisher stopped")
         finally:
-            os.killpg(spawner.pid, signal.SIGINT)
-            spawner.wait(WALL_TIMEOUT)
+            interrupt(spawner)
         wait_for(lambda: "extra_joint_publisher" not in self.states(), what="the spawner to unload on exit")
         self.assertEqual(spawner.returncode, 0)
 
@@ -104,8 +114,7 @@ class RosControlQuad(unittest.TestCase):
         try:
             wait_for(lambda: self.states()[CONTROLLER] == "stopped", what="the unspawner to stop the controller")
         finally:
-            os.killpg(unspawner.pid, signal.SIGINT)
-            unspawner.wait(WALL_TIMEOUT)
+            interrupt(unspawner)
         wait_for(lambda: self.states()[CONTROLLER] == "running", what="the unspawner to restart it on exit")
 
 

@@ -55,9 +55,9 @@ def raw_pybullet_rtf(sim_seconds: float) -> float:
     return sim_seconds / elapsed
 
 
-def _launch(*arguments):
-    return subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false", "real_time_factor:=0",
-                             *arguments], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+def _launch():
+    return subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false", "real_time_factor:=0"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
 
 
 def first_odom_seconds() -> float:

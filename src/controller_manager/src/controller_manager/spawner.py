@@ -10,7 +10,6 @@ unloaded while the node can still call services, rather than from rospy's shutdo
 """
 import argparse
 import os
-import signal
 import sys
 import threading
 import time
@@ -20,6 +19,8 @@ import rospy
 import yaml
 from controller_manager_msgs.srv import LoadController, SwitchController, SwitchControllerRequest, UnloadController
 from std_msgs.msg import Bool
+
+from .stop_signal import stop_on_signals
 
 _POLL_SECONDS = 0.5
 
@@ -144,9 +145,7 @@ class Spawner:
 
 def main():
     args = parse_args(rospy.myargv()[1:])
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
+    stop = stop_on_signals()
     rospy.init_node("spawner", anonymous=True, disable_signals=True)
     if args.shutdown_timeout is not None:
         rospy.logwarn("DEPRECATION warning: --shutdown-timeout has no effect.")

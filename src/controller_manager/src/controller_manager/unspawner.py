@@ -1,10 +1,10 @@
 """``unspawner NAME ...``: stops the named running controllers until it is killed, then starts them again."""
-import signal
 import sys
-import threading
 
 import rospy
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
+
+from .stop_signal import stop_on_signals
 
 HELP = """./unspawner name1 name2 name3
 
@@ -17,9 +17,7 @@ def main():
     if not names or names[0] in ("-h", "--help"):
         print(HELP)
         sys.exit(1)
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
+    stop = stop_on_signals()
     rospy.init_node("unspawner", anonymous=True, disable_signals=True)
     switch = rospy.ServiceProxy("controller_manager/switch_controller", SwitchController)
     list_controllers = rospy.ServiceProxy("controller_manager/list_controllers", ListControllers)
