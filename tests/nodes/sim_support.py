@@ -1,5 +1,6 @@
 """Helpers shared by the rostest nodes: waiting on conditions, ground truth, driving through /cmd_vel."""
 import math
+import sys
 import time
 
 import rospy
@@ -20,6 +21,16 @@ def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
             return value
         time.sleep(0.01)
     raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
+
+
+def print_figures(lines):
+    """A test's measurements, one ``figure:`` line each on stderr, where ./mbot test picks them up."""
+    print("\n".join([""] + ["figure: " + line for line in lines]), file=sys.stderr)
+
+
+def controller_states(list_controllers) -> dict:
+    """controller name -> state, from a controller_manager/list_controllers service proxy."""
+    return {state.name: state.state for state in list_controllers().controller}
 
 
 def yaw_of(orientation):

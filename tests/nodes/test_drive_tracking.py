@@ -4,7 +4,6 @@
 Prints the measured figures; each is checked against the tolerance of the workspace's acceptance list.
 """
 import math
-import sys
 import unittest
 
 import rospy
@@ -12,7 +11,7 @@ import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
-from sim_support import Simulator, roll_pitch_of, wait_for, yaw_of
+from sim_support import Simulator, print_figures, roll_pitch_of, wait_for, yaw_of
 
 SETTLE_SECONDS = 2.0  # a steady command for this long before measuring
 MEASURE_SECONDS = 1.0
@@ -27,9 +26,8 @@ class DriveTracking(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join(["", f"figure: tracking, from ground truth {SETTLE_SECONDS:.0f} s after each command, over "
-                             f"{MEASURE_SECONDS:.0f} s:"] + ["figure: " + line for line in cls.figures]),
-              file=sys.stderr)
+        print_figures([f"tracking, from ground truth {SETTLE_SECONDS:.0f} s after each command, over "
+                       f"{MEASURE_SECONDS:.0f} s:"] + cls.figures)
 
     def steady_motion(self, linear, angular):
         """Reset, command, settle, then measure over a window: (speed along heading, yaw rate, worst tilt, z)."""

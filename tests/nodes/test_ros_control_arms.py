@@ -3,7 +3,6 @@
 effort_controllers/JointPositionController (PID to effort), /position_arm with
 position_controllers/JointGroupPositionController. Joint angles come from each arm's joint_state_controller."""
 import math
-import sys
 import unittest
 
 import rospy
@@ -12,7 +11,7 @@ from controller_manager_msgs.srv import ListControllers
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 
-from sim_support import WALL_TIMEOUT, wait_for
+from sim_support import WALL_TIMEOUT, print_figures, wait_for
 
 SETPOINTS = ((0.5, -0.8), (-1.0, 1.2), (1.5, 0.3))
 TOLERANCE_DEGREES = 1.0
@@ -36,7 +35,7 @@ class RosControlArms(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join([""] + ["figure: " + line for line in cls.figures]), file=sys.stderr)
+        print_figures(cls.figures)
 
     def errors(self, arm, setpoint):
         state = self.states[arm]

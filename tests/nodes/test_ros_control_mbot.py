@@ -5,7 +5,6 @@ Tracking and odometry are measured against ground truth (/gazebo/get_model_state
 the controller manager's services are checked against upstream's behaviour and error texts.
 """
 import math
-import sys
 import threading
 import unittest
 
@@ -19,7 +18,7 @@ from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from rosgraph_msgs.msg import Log
 from std_srvs.srv import Empty
 
-from sim_support import WALL_TIMEOUT, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
 
 CONTROLLER = "mobile_base_controller"
 SETTLE_SECONDS = 2.0
@@ -76,11 +75,11 @@ class RosControlMbot(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join([""] + ["figure: " + line for line in cls.figures]), file=sys.stderr)
+        print_figures(cls.figures)
 
     @classmethod
     def states(cls):
-        return {state.name: state.state for state in cls.list_controllers().controller}
+        return controller_states(cls.list_controllers)
 
     @classmethod
     def repeat_command(cls):

@@ -4,9 +4,7 @@ drives forward at the commanded speed and turns left on a positive angular.z; /j
 wheels; the spawner's --stopped, YAML-file and shutdown paths are exercised on a second controller."""
 import math
 import os
-import signal
 import subprocess
-import sys
 import unittest
 
 import rospy
@@ -16,20 +14,10 @@ from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
-from sim_support import WALL_TIMEOUT, wait_for, yaw_of
+from mbot_gazebo.processes import stop_process_group
+from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
 
 CONTROLLER = "quad_velocity_controller"
-
-
-def interrupt(process: subprocess.Popen):
-    """Ctrl-C to a command started in a session of its own; one that does not exit fails the test and is killed."""
-    os.killpg(process.pid, signal.SIGINT)
-    try:
-        process.wait(WALL_TIMEOUT)
-    except subprocess.TimeoutExpired:
-        os.killpg(process.pid, signal.SIGKILL)
-        process.wait()
-        raise AssertionError(f"{' '.join(process.args)} did not exit within {WALL_TIMEOUT} s of SIGINT") from None
 
 
 class RosControlQuad(unittest.TestCase):
@@ -48,11 +36,11 @@ class RosControlQuad(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        print("\n".join([""] + ["figure: " + line for line in cls.figures]), file=sys.stderr)
+        print_figures(cls.figures)
 
     @classmethod
     def states(cls):
-        return {state.name: state.state for state in cls.list_controllers().controller}
+        return controller_states(cls.list_controllers)
 
     def pose(self):
         return self.get_model_state("quad_base", "world").pose
@@ -101,7 +89,8 @@ class RosControlQuad(unittest.TestCase):
             wait_for(lambda: self.states().get("extra_joint_publisher") == "initialized",
                      what="the spawner to load extra_joint_publisher stopped")
         finally:
-            interrupt(spawner)
+            exited = stop_process_group(spawner, WALL_TIMEOUT)
+        self.assertTrue(exited, "the spawner did not exit on SIGINT")
         wait_for(lambda: "extra_joint_publisher" not in self.states(), what="the spawner to unload on exit")
         self.assertEqual(spawner.returncode, 0)
 
@@ -114,7 +103,8 @@ class RosControlQuad(unittest.TestCase):
         try:
             wait_for(lambda: self.states()[CONTROLLER] == "stopped", what="the unspawner to stop the controller")
         finally:
-            interrupt(unspawner)
+            exited = stop_process_group(unspawner, WALL_TIMEOUT)
+        self.assertTrue(exited, "the unspawner did not exit on SIGINT")
         wait_for(lambda: self.states()[CONTROLLER] == "running", what="the unspawner to restart it on exit")
 
 

@@ -15,16 +15,20 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def stop_process_group(process: subprocess.Popen, timeout: float = 20.0):
-    """SIGINT the process's group (started with start_new_session=True), as Ctrl-C would; SIGKILL if it hangs."""
+def stop_process_group(process: subprocess.Popen, timeout: float = 20.0) -> bool:
+    """SIGINT the process's group (started with start_new_session=True), as Ctrl-C would; SIGKILL if it hangs.
+
+    False when it had to be killed (it ignored Ctrl-C for ``timeout`` seconds)."""
     if process.poll() is not None:
-        return
+        return True
     os.killpg(process.pid, signal.SIGINT)
     try:
         process.wait(timeout=timeout)
+        return True
     except subprocess.TimeoutExpired:
         os.killpg(process.pid, signal.SIGKILL)
         process.wait()
+        return False
 
 
 class PrivateMaster:
