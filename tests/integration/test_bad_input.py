@@ -3,6 +3,8 @@ import pytest
 
 from ros_processes import run
 
+pytestmark = pytest.mark.long
+
 BAD_DRIVE = """<robot name="lopsided">
   <link name="chassis"><inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/>
     </inertial><collision><geometry><box size="0.3 0.2 0.05"/></geometry></collision></link>

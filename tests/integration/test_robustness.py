@@ -16,6 +16,8 @@ import yaml
 from mbot_gazebo.processes import PrivateMaster, stop_process_group
 from ros_processes import run, wait_until
 
+pytestmark = pytest.mark.long
+
 # A first spawn waits for the bridge's services; later calls are answered at once.
 CALL_TIMEOUT = 60
 # Far below what any refusal takes; before the fixes a blocked bridge ran into it.

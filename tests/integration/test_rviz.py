@@ -23,6 +23,8 @@ from mbot_gazebo.processes import stop_process_group
 from ros_processes import TESTS, wait_until
 from xvfb import Xvfb
 
+pytestmark = pytest.mark.long
+
 CONFIGS = sorted(glob.glob(os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config", "*.rviz")))
 TF_ERRORS = ("TF_OLD_DATA", "TF_REPEATED_DATA", "Lookup would require extrapolation", "No transform from",
              "Could not transform")

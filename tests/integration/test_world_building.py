@@ -11,6 +11,8 @@ from mbot_sim_bridge.core.sdf_world import parse_world
 
 from ros_processes import TESTS, run, wait_until
 
+pytestmark = pytest.mark.long
+
 WORLDS = os.path.join(os.path.dirname(TESTS), "worlds")
 POSITION_TOLERANCE = 1e-3  # m
 ANGLE_TOLERANCE = 1e-3  # rad

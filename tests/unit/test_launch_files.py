@@ -9,6 +9,8 @@ import roslaunch.rlutil
 
 from ros_processes import TESTS
 
+pytestmark = pytest.mark.long
+
 WORKSPACE = os.path.dirname(TESTS)
 LAUNCH_FILES = sorted(glob.glob(os.path.join(WORKSPACE, "src", "*", "launch", "*.launch"))
                       + glob.glob(os.path.join(TESTS, "*.test")))

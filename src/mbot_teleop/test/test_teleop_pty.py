@@ -22,6 +22,8 @@ import rosgraph
 from teleop_harness import (
     PACKAGE_DIR, PtyProcess, TwistRecorder, source_env, stop, teleop_command, wait_until)
 
+pytestmark = pytest.mark.long
+
 NOT_A_TERMINAL = ('mbot_teleop: stdin is not a terminal; run it from a terminal: '
                   'rosrun mbot_teleop mbot_teleop.py')
 START_TIMEOUT = 30.0  # s: a cold start of rospy on a busy machine

@@ -89,7 +89,7 @@ def refused(kind, error):
 
 
 @pytest.fixture(scope="module", autouse=True)
-def print_outcomes(request):
+def print_outcomes():
     # A case that asks for absurd memory fails here with MemoryError instead of starving the machine.
     limits = resource.getrlimit(resource.RLIMIT_AS)
     resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT_BYTES, limits[1]))
@@ -99,11 +99,9 @@ def print_outcomes(request):
     yield
     bridge_logger.setLevel(level)
     resource.setrlimit(resource.RLIMIT_AS, limits)
-    capture = request.config.pluginmanager.getplugin("capturemanager")
-    with capture.global_and_fixture_disabled():
-        for kind, counts in OUTCOMES.items():
-            details = ", ".join(f"{count} {outcome}" for outcome, count in sorted(counts.items()))
-            print(f"\nfigure: fuzz {kind}: {sum(counts.values())} cases: {details}")
+    for kind, counts in OUTCOMES.items():
+        details = ", ".join(f"{count} {outcome}" for outcome, count in sorted(counts.items()))
+        print(f"figure: fuzz {kind}: {sum(counts.values())} cases: {details}")
 
 
 # -- mutations ----------------------------------------------------------------------------------------------------
