@@ -31,11 +31,11 @@ def test_overlap_probe_tells_resting_from_tunnelled(probe):
     assert probe.measure({ROBOT: pose_from_xyz_rpy((0, 0, -0.1), (0, 0, 0))}) < -TUNNEL_DEPTH
 
 
-def test_short_soak_passes():
+def test_short_soak_passes(tmp_path):
     """Half a minute (the first half is the memory warm-up) of random driving at full speed: several hundred
-    seconds of sim time, the same checks as a long soak."""
+    seconds of sim time, the same checks as a long soak. Its log folder goes under the test's own."""
     result = subprocess.run([os.path.join(ROOT, "mbot"), "soak", "0.5"], capture_output=True, text=True,
-                            timeout=600)
+                            timeout=600, env=dict(os.environ, TMPDIR=str(tmp_path)))
     output = result.stdout + result.stderr
     assert result.returncode == 0, output
     figures = [line for line in result.stdout.splitlines() if line.startswith("figure: soak")]

@@ -29,14 +29,11 @@ from sensor_msgs.msg import Image, Imu  # noqa: E402 (after the path set-up)
 from mbot_sim_bridge.core.camera import RENDERER_ENV, Camera, DepthCamera  # noqa: E402
 from mbot_sim_bridge.core.diff_drive import DiffDrive  # noqa: E402
 from mbot_sim_bridge.core.imu import ImuModelPlugin  # noqa: E402
-from mbot_sim_bridge.core.joint_states import JointStatePublisher  # noqa: E402
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS  # noqa: E402
 from mbot_sim_bridge.core.robot_model import parse_robot  # noqa: E402
 from mbot_sim_bridge.core.sdf_world import parse_world  # noqa: E402
 from mbot_sim_bridge.core.simulation import Simulation  # noqa: E402
 
-REGISTRY = {"libgazebo_ros_diff_drive.so": DiffDrive, "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
-            "libgazebo_ros_camera.so": Camera, "libgazebo_ros_openni_kinect.so": DepthCamera,
-            "libgazebo_ros_imu.so": ImuModelPlugin}
 PLAY_GROUND = os.path.join(WORKSPACE, "src", "mbot_gazebo", "worlds", "playground.world")
 SIZES = ((320, 240), (640, 480), (1280, 720))
 # TurtleBot3 burger's IMU plugin block (turtlebot3_burger.gazebo.xacro), on a board lumped into the base.
@@ -58,7 +55,7 @@ def course_urdf(name: str) -> str:
 
 
 def spawn(urdf: str):
-    sim = Simulation(parse_world(PLAY_GROUND), REGISTRY)
+    sim = Simulation(parse_world(PLAY_GROUND), CORE_PLUGINS)
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot")
     return sim, spawned
 

@@ -28,17 +28,14 @@ def raw_robots_rtf(sim_seconds: float) -> float:
     import xacro
     from mbot_sim_bridge.core.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-    from mbot_sim_bridge.core.joint_states import JointStatePublisher
-    from mbot_sim_bridge.core.lidar import RaySensor
+    from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
     from mbot_sim_bridge.core.robot_model import parse_robot
     from mbot_sim_bridge.core.sdf_world import parse_world
     from mbot_sim_bridge.core.simulation import Simulation
 
-    registry = {"libgazebo_ros_diff_drive.so": DiffDrive, "libgazebo_ros_laser.so": RaySensor,
-                "libgazebo_ros_joint_state_publisher.so": JointStatePublisher}
     urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
                                            "mbot_with_laser_gazebo.xacro"), mappings={}).toxml()
-    sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), registry)
+    sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), CORE_PLUGINS)
     for index in range(ROBOTS):  # the places and turn rates of multi_mbot.launch and the bridge run below
         place = pose_from_xyz_rpy((-1.0 + 0.8 * (index % 5), -0.5 + 1.0 * (index // 5), 0), (0, 0, 0))
         spawned = sim.spawn_robot(parse_robot(urdf), f"mbot_{index + 1}", place)

@@ -191,17 +191,14 @@ def camera_frame(world_path: str, x: float, y: float, yaw: float):
     simulator runs (core/camera.py), rendered in a world of its own, without ROS."""
     import xacro
     from mbot_sim_bridge.core.camera import DepthCamera
-    from mbot_sim_bridge.core.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-    from mbot_sim_bridge.core.joint_states import JointStatePublisher
+    from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
     from mbot_sim_bridge.core.robot_model import parse_robot
     from mbot_sim_bridge.core.simulation import Simulation
 
     urdf = xacro.process_file(os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
                                            "mbot_with_kinect_gazebo.xacro")).toxml()
-    registry = {"libgazebo_ros_openni_kinect.so": DepthCamera, "libgazebo_ros_diff_drive.so": DiffDrive,
-                "libgazebo_ros_joint_state_publisher.so": JointStatePublisher}
-    simulation = Simulation(parse_world(world_path), registry)
+    simulation = Simulation(parse_world(world_path), CORE_PLUGINS)
     try:
         spawned = simulation.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot",
                                          pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, yaw)))

@@ -2,26 +2,9 @@
 course's mbot with an IMU, p3d and their sensors added the way a Gazebo user writes them."""
 import os
 
-from mbot_sim_bridge.core.camera import Camera, DepthCamera, PlainDepthCamera
-from mbot_sim_bridge.core.diff_drive import DiffDrive
-from mbot_sim_bridge.core.imu import ImuModelPlugin, ImuSensor
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
-from mbot_sim_bridge.core.lidar import RaySensor
-from mbot_sim_bridge.core.p3d import P3D
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
-
-CORE_REGISTRY = {
-    "libgazebo_ros_diff_drive.so": DiffDrive,
-    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
-    "libgazebo_ros_laser.so": RaySensor,
-    "libgazebo_ros_camera.so": Camera,
-    "libgazebo_ros_openni_kinect.so": DepthCamera,
-    "libgazebo_ros_depth_camera.so": PlainDepthCamera,
-    "libgazebo_ros_imu.so": ImuModelPlugin,
-    "libgazebo_ros_imu_sensor.so": ImuSensor,
-    "libgazebo_ros_p3d.so": P3D,
-}
 
 _WORLD = """<?xml version="1.0"?>
 <sdf version="1.6"><world name="default">
@@ -49,7 +32,7 @@ def world_simulation(tmp_path, *models, seed=0) -> Simulation:
     path = os.path.join(str(tmp_path), "sensors.world")
     with open(path, "w") as world:
         world.write(_WORLD.format(models="\n  ".join(models)))
-    return Simulation(parse_world(path), CORE_REGISTRY, seed=seed)
+    return Simulation(parse_world(path), CORE_PLUGINS, seed=seed)
 
 
 def plugin_of(spawned, plugin_class):

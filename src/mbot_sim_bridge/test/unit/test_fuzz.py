@@ -23,9 +23,8 @@ from hypothesis import strategies as st
 from mbot_sim_bridge.core.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
-from mbot_sim_bridge.core.lidar import RaySensor
 from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
 from mbot_sim_bridge.core.sdf_world import parse_world
@@ -34,11 +33,6 @@ from mbot_sim_bridge.core.simulation import Simulation
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORLDS = os.path.join(HERE, "..", "..", "..", "..", "worlds")
 TEST_WORLDS = os.path.join(HERE, "..", "worlds")
-CORE_REGISTRY = {
-    "libgazebo_ros_diff_drive.so": DiffDrive,
-    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
-    "libgazebo_ros_laser.so": RaySensor,
-}
 # One case may take this long (a spawn, a world load, a few hundred steps) before it counts as a hang.
 CASE_SECONDS = 10.0
 STEPS = 200
@@ -184,7 +178,7 @@ def step_and_check(sim, label, command=(0.5, 1.0)):
 # -- robot descriptions -------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def simulation():
-    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_REGISTRY)
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS)
     yield sim
     sim.close()
 
@@ -260,7 +254,7 @@ def test_malformed_worlds(data, world_directory):
     try:
         with watchdog():
             world = parse_world(path, model_path)
-            sim = Simulation(world, CORE_REGISTRY)
+            sim = Simulation(world, CORE_PLUGINS)
     except BridgeError as error:
         refused("worlds", error)
         return
@@ -342,7 +336,7 @@ def _apply(sim, request, mbot_urdf):
 @given(requests=st.lists(REQUESTS, min_size=1, max_size=4))
 def test_garbage_requests(requests, mbot_model, mbot_urdf):
     """A fresh world with the mbot for each sequence, so that a failure shrinks to the requests that made it."""
-    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_REGISTRY)
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS)
     try:
         sim.spawn_robot(mbot_model, "mbot")
         for request in requests:

@@ -13,7 +13,7 @@ from mbot_sim_bridge.core.controllers import DiffDriveOdometry, SpeedLimiter
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.gazebo_ros_control import RosControl
 from mbot_sim_bridge.core.geometry import yaw
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control import (JointLimits, Pid, apply_limit_params, parse_transmissions,
                                               shortest_angular_distance_with_limits)
@@ -43,8 +43,7 @@ def simulate(urdf, params, name="robot"):
             return params.get(path)
 
     sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")),
-                     {"libgazebo_ros_control.so": CoreRosControl,
-                      "libgazebo_ros_joint_state_publisher.so": JointStatePublisher})
+                     {**CORE_PLUGINS, "libgazebo_ros_control.so": CoreRosControl})
     spawned = sim.spawn_robot(parse_robot(urdf, f"model '{name}'"), name)
     plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, RosControl))
     return sim, spawned, plugin

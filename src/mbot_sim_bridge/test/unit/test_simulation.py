@@ -12,21 +12,16 @@ from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.lidar import RaySensor
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds")
-# The core classes under the Gazebo file names, as plugins/registry.py maps the ROS classes.
-CORE_REGISTRY = {
-    "libgazebo_ros_diff_drive.so": DiffDrive,
-    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
-    "libgazebo_ros_laser.so": RaySensor,
-}
 
 
 def simulation(world="empty.world", seed=0):
-    return Simulation(parse_world(os.path.join(WORLDS, world)), CORE_REGISTRY, seed=seed)
+    return Simulation(parse_world(os.path.join(WORLDS, world)), CORE_PLUGINS, seed=seed)
 
 
 def plugin_of(spawned, plugin_class):

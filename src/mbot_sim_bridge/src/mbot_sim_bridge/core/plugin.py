@@ -2,7 +2,7 @@
 
 A Gazebo plugin is one core module (a ``Plugin`` subclass that reads its tags, drives joints or senses, and
 computes its outputs, with no ROS), one ROS module (a subclass that adds the publishers and subscribers)
-and one line in ``plugins/registry.py``. The Simulation builds every plugin the same way, calls
+and one line in the plugin table (``core/plugin_table.py``). The Simulation builds every plugin the same way, calls
 ``update(now)`` when its timer is due and ``on_step`` after each physics step if it asks for it.
 """
 from dataclasses import dataclass
@@ -70,6 +70,18 @@ class Plugin:
     def label(self) -> str:
         """How messages name the plugin, as gazebo_ros's own do: 'GazeboRosDiffDrive(ns = /)'."""
         return f"{self.GAZEBO_CLASS or type(self).__name__}(ns = {self.namespace_tag() or self.context.model.name})"
+
+    @classmethod
+    def plugin_element(cls, filename: str, name: str, **tags: str) -> ElementTree.Element:
+        """The ``<plugin>`` block a Gazebo user would write, for a plugin the simulator adds by itself; the tags
+        are checked against PARAMS, so the block reads back as written."""
+        unknown = sorted(set(tags) - {param.tag for param in cls.PARAMS})
+        if unknown:
+            raise ValueError(f"{cls.__name__} has no tags {', '.join(unknown)}")
+        element = ElementTree.Element("plugin", name=name, filename=filename)
+        for tag, text in tags.items():
+            ElementTree.SubElement(element, tag).text = text
+        return element
 
     def namespace_tag(self) -> Optional[str]:
         element = self.element.find("robotNamespace")

@@ -3,7 +3,8 @@ schedule, spawn/delete/reset in Gazebo's order, and the random streams of the no
 
 The ROS node runs ``advance`` in its loop and publishes /clock from the ``before_updates`` hook; the unit
 tests run the same ``advance`` with the plugins' core classes. Plugins are built from a registry
-(Gazebo file name -> class) handed in, so the core never imports the ROS plugin layer.
+(Gazebo file name -> class) handed in: the plugin table's core classes (``plugin_table.CORE_PLUGINS``) or the
+ROS layer's registry derived from it, so the core never imports the ROS plugin layer.
 """
 import hashlib
 from dataclasses import dataclass, field, replace
@@ -16,8 +17,10 @@ import pybullet
 from .engine import Engine, SpawnedRobot
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose
+from .joint_states import JointStatePublisher
 from .log import get_logger, warn_once
 from .plugin import Plugin, PluginContext
+from .plugin_table import filename_of
 from .robot_model import RobotModel
 from .sdf_world import ModelDescription, WorldDescription
 from .viewer import Viewer
@@ -26,7 +29,7 @@ from .world_bodies import load_world
 _logger = get_logger(__name__)
 
 # The bridge publishes the joint states no plugin publishes through this plugin, as a Gazebo user would add it.
-JOINT_STATE_PLUGIN = "libgazebo_ros_joint_state_publisher.so"
+JOINT_STATE_PLUGIN = filename_of(JointStatePublisher)
 # Above this many links a spawn takes seconds (PyBullet's URDF import): said first, so a pause is explained.
 LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
@@ -193,11 +196,9 @@ class Simulation:
 
     def _joint_state_element(self, spawned: SpawnedModel, joints: Sequence[str]) -> ElementTree.Element:
         """The libgazebo_ros_joint_state_publisher.so block a Gazebo user would add for these joints."""
-        element = ElementTree.Element("plugin", name="bridge_joint_state_publisher", filename=JOINT_STATE_PLUGIN)
-        for tag, text in (("robotNamespace", spawned.namespace), ("jointName", ", ".join(joints)),
-                          ("updateRate", repr(self.joint_state_rate))):
-            ElementTree.SubElement(element, tag).text = text
-        return element
+        return JointStatePublisher.plugin_element(JOINT_STATE_PLUGIN, "bridge_joint_state_publisher",
+                                                  robotNamespace=spawned.namespace, jointName=", ".join(joints),
+                                                  updateRate=repr(self.joint_state_rate))
 
     def _schedule(self):
         self._plugins = [plugin for spawned in self.models.values() for plugin in spawned.plugins]

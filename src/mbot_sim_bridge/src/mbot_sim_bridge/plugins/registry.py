@@ -1,24 +1,47 @@
-"""Gazebo plugin file name -> the class that emulates it. Adding a plugin adds one line here."""
-from .gazebo_ros_camera import GazeboRosCamera
-from .gazebo_ros_control import GazeboRosControl
-from .gazebo_ros_diff_drive import GazeboRosDiffDrive
-from .gazebo_ros_joint_state_publisher import GazeboRosJointStatePublisher
-from .gazebo_ros_imu import GazeboRosImu
-from .gazebo_ros_imu_sensor import GazeboRosImuSensor
-from .gazebo_ros_laser import GazeboRosLaser
-from .gazebo_ros_openni_kinect import GazeboRosDepthCamera, GazeboRosOpenniKinect
-from .gazebo_ros_p3d import GazeboRosP3D
+"""Gazebo plugin file name -> the ROS class that emulates it, derived from the one plugin table
+(``core/plugin_table.py``).
 
-REGISTRY = {
-    "libgazebo_ros_control.so": GazeboRosControl,
-    "libgazebo_ros_diff_drive.so": GazeboRosDiffDrive,
-    "libgazebo_ros_joint_state_publisher.so": GazeboRosJointStatePublisher,
-    "libgazebo_ros_laser.so": GazeboRosLaser,
-    "libgazebo_ros_gpu_laser.so": GazeboRosLaser,
-    "libgazebo_ros_camera.so": GazeboRosCamera,
-    "libgazebo_ros_openni_kinect.so": GazeboRosOpenniKinect,
-    "libgazebo_ros_depth_camera.so": GazeboRosDepthCamera,
-    "libgazebo_ros_imu.so": GazeboRosImu,
-    "libgazebo_ros_imu_sensor.so": GazeboRosImuSensor,
-    "libgazebo_ros_p3d.so": GazeboRosP3D,
-}
+A plugin's ROS class is the class of this package whose nearest core ancestor is the table's core class (the
+ROS side of ``DepthCamera`` is ``GazeboRosOpenniKinect``; of ``PlainDepthCamera``, ``GazeboRosDepthCamera``,
+which extends both). Every module of this package is imported to find them, so adding a plugin needs no line
+here.
+"""
+import importlib
+import pkgutil
+
+from ..core.plugin import Plugin
+from ..core.plugin_table import CORE_PLUGINS
+
+_PACKAGE = __name__.rsplit(".", 1)[0]
+_CORE_PACKAGE = Plugin.__module__.rsplit(".", 1)[0]
+
+
+def _ros_classes():
+    classes = []
+    for module_info in pkgutil.iter_modules(importlib.import_module(_PACKAGE).__path__):
+        module = importlib.import_module(f"{_PACKAGE}.{module_info.name}")
+        classes += [value for value in vars(module).values()
+                    if isinstance(value, type) and issubclass(value, Plugin) and value.__module__ == module.__name__]
+    return classes
+
+
+def _nearest_core_class(ros_class: type) -> type:
+    return next(base for base in ros_class.__mro__[1:] if base.__module__.startswith(_CORE_PACKAGE + "."))
+
+
+def _derive():
+    faces = {}
+    for ros_class in _ros_classes():
+        faces.setdefault(_nearest_core_class(ros_class), []).append(ros_class)
+    registry = {}
+    for filename, core_class in CORE_PLUGINS.items():
+        candidates = faces.get(core_class, [])
+        if len(candidates) != 1:
+            found = ", ".join(candidate.__name__ for candidate in candidates) or "none"
+            raise ImportError(f"{filename}: {_PACKAGE} must have one class extending {core_class.__name__} first; "
+                              f"found {found}")
+        registry[filename] = candidates[0]
+    return registry
+
+
+REGISTRY = _derive()

@@ -1,0 +1,33 @@
+"""Every emulated Gazebo plugin: the file name a ``<plugin filename=...>`` gives -> its core class (no ROS).
+
+This is the one plugin table. The ROS node's registry (``plugins/registry.py``) is derived from it, and the demo,
+the benchmarks and the tests build their Simulations from it; adding a plugin adds one line here.
+"""
+from typing import Dict
+
+from .camera import Camera, DepthCamera, PlainDepthCamera
+from .diff_drive import DiffDrive
+from .gazebo_ros_control import RosControl
+from .imu import ImuModelPlugin, ImuSensor
+from .joint_states import JointStatePublisher
+from .lidar import RaySensor
+from .p3d import P3D
+
+CORE_PLUGINS: Dict[str, type] = {
+    "libgazebo_ros_control.so": RosControl,
+    "libgazebo_ros_diff_drive.so": DiffDrive,
+    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
+    "libgazebo_ros_laser.so": RaySensor,
+    "libgazebo_ros_gpu_laser.so": RaySensor,
+    "libgazebo_ros_camera.so": Camera,
+    "libgazebo_ros_openni_kinect.so": DepthCamera,
+    "libgazebo_ros_depth_camera.so": PlainDepthCamera,
+    "libgazebo_ros_imu.so": ImuModelPlugin,
+    "libgazebo_ros_imu_sensor.so": ImuSensor,
+    "libgazebo_ros_p3d.so": P3D,
+}
+
+
+def filename_of(plugin_class: type) -> str:
+    """The (first) file name under which the core class ``plugin_class`` is in the table."""
+    return next(filename for filename, core_class in CORE_PLUGINS.items() if core_class is plugin_class)
