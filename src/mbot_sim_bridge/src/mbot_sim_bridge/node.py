@@ -26,7 +26,9 @@ from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
 from .core.xml_values import parse_bool
 from .plugins import loop_publisher, ros_time
 from .publisher_check import check_joint_state_publishers
+from .package_uris import resolve_package_uris
 from .plugins.registry import REGISTRY
+from .ros_parameters import RosParameters
 from .services import GazeboRosApi
 
 DEFAULT_CLOCK_FREQUENCY = 100.0
@@ -65,7 +67,8 @@ class SimBridgeNode:
         if requested_gui and not gui:
             why = "headless:=true" if headless else "no DISPLAY is set"
             rospy.loginfo(f"gui:=true, but {why}: running without a window")
-        self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate)
+        self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate,
+                              RosParameters(), resolve_package_uris)
         self.sim.paused = paused or lockstep
         physics = world.physics
         self.step_size = physics.max_step_size

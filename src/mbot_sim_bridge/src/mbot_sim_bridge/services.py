@@ -4,12 +4,10 @@ Handlers run in rospy's threads; each converts the request into Simulation calls
 thread (``node.call_in_loop``) and the result back into a response.
 """
 import math
-import re
 import tempfile
 from typing import Optional
 from xml.etree import ElementTree
 
-import rospkg
 import rospy
 from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
                              GetPhysicsProperties, GetPhysicsPropertiesResponse, GetWorldProperties,
@@ -28,6 +26,7 @@ from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
 from .core.sdf_world import parse_world
 from .model_states import ModelStatesPublisher
+from .package_uris import resolve_package_uris
 from .plugins import ros_time
 from .subscriptions import drain
 from .world_saving import SaveWorldHandler
@@ -59,18 +58,6 @@ def _twist_message(linear, angular) -> Twist:
     twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
     twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
     return twist
-
-
-def _resolve_package_uris(xml: str) -> str:
-    """package://pkg/ -> the package's absolute path, as spawn_urdf_model does (PyBullet knows no packages)."""
-    packages = rospkg.RosPack()
-
-    def replace(match):
-        try:
-            return packages.get_path(match.group(1)) + "/"
-        except rospkg.ResourceNotFound:
-            raise ModelError(f"package://{match.group(1)}/ in the model: no such package") from None
-    return re.sub(r"package://([^/]+)/", replace, xml)
 
 
 class GazeboRosApi:
@@ -122,7 +109,7 @@ class GazeboRosApi:
         def spawn():
             name = request.model_name
             pose = self._new_model_pose(request)
-            model = parse_robot(_resolve_package_uris(request.model_xml), f"model '{name}'")
+            model = parse_robot(resolve_package_uris(request.model_xml), f"model '{name}'")
             namespace = request.robot_namespace
             if namespace:
                 _inject_namespace(model, namespace)
@@ -135,7 +122,7 @@ class GazeboRosApi:
         def spawn():
             name = request.model_name
             pose = self._new_model_pose(request)
-            world_xml = spawn_world_xml(_resolve_package_uris(request.model_xml), name, pose)
+            world_xml = spawn_world_xml(resolve_package_uris(request.model_xml), name, pose)
             # The world loader reads files (relative URIs resolve against them); a private temp file holds it.
             with tempfile.NamedTemporaryFile("w", prefix="mbot_spawn_", suffix=".world") as world_file:
                 world_file.write(world_xml)

@@ -13,6 +13,7 @@ from mbot_sim_bridge.core.controllers import DiffDriveOdometry, SpeedLimiter
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.gazebo_ros_control import RosControl
 from mbot_sim_bridge.core.geometry import yaw
+from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control import (JointLimits, Pid, apply_limit_params, parse_transmissions,
@@ -33,18 +34,21 @@ def load_yaml(path):
         return yaml.safe_load(stream)
 
 
-def simulate(urdf, params, name="robot"):
-    """A Simulation with the robot spawned; its gazebo_ros_control reads ``params`` as the parameter server."""
-    class CoreRosControl(RosControl):
-        def controller_params(self, controller):
-            return params.get(controller)
-
-        def ros_param(self, path):
-            return params.get(path)
-
-    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")),
-                     {**CORE_PLUGINS, "libgazebo_ros_control.so": CoreRosControl})
-    spawned = sim.spawn_robot(parse_robot(urdf, f"model '{name}'"), name)
+def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None):
+    """A Simulation with the robot spawned from ``urdf``, which is also its robot_description parameter; its
+    gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default the
+    model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
+    tree = {"robot_description": urdf}
+    for path, value in [((namespace or name) + "/" + key, config) for key, config in controllers.items()] + list(
+            (parameters or {}).items()):
+        *parents, leaf = path.strip("/").split("/")
+        node = tree
+        for parent in parents:
+            node = node.setdefault(parent, {})
+        node[leaf] = value
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS,
+                     parameters=Parameters(tree), package_uris=package_uris)
+    spawned = sim.spawn_robot(parse_robot(package_uris(urdf), f"model '{name}'"), name)
     plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, RosControl))
     return sim, spawned, plugin
 
@@ -66,7 +70,7 @@ def mbot_ros_control_urdf():
 
 @pytest.fixture
 def mbot(mbot_ros_control_urdf):
-    sim, spawned, plugin = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot")
+    sim, spawned, plugin = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
     manager = plugin.manager
     assert manager.load("joint_state_controller", plugin.urdf)
     assert manager.load("mobile_base_controller", plugin.urdf)
@@ -90,7 +94,7 @@ TRANSMISSIONS = """<robot name="t">
 
 def test_transmissions_are_read_at_joint_and_old_actuator_level(caplog):
     document = parse_xml(TRANSMISSIONS.encode(), "test")
-    transmissions = parse_transmissions(document.root, document.where)
+    transmissions = parse_transmissions(document.root.findall("transmission"), document.where)
     assert [t.name for t in transmissions] == ["new_style", "old_style"]
     assert transmissions[0].joints == [("a", ["hardware_interface/EffortJointInterface"])]
     assert transmissions[0].actuators == [("a_motor", [], 50.0)]
@@ -101,7 +105,7 @@ def test_transmissions_are_read_at_joint_and_old_actuator_level(caplog):
 def test_a_bad_mechanical_reduction_is_refused():
     document = parse_xml(TRANSMISSIONS.replace(">50<", ">fifty<").encode(), "test")
     with pytest.raises(ConfigError, match="<mechanicalReduction> 'fifty' is not a number"):
-        parse_transmissions(document.root, document.where)
+        parse_transmissions(document.root.findall("transmission"), document.where)
 
 
 def test_the_mbot_wheels_are_velocity_joints_without_limits(mbot):
@@ -372,10 +376,10 @@ def test_pid_gains_turn_position_joints_into_pid_driven_effort_joints(legacy):
         urdf = urdf.replace(plugin_element, plugin_element.replace("/>", "><legacyModeNS>true</legacyModeNS></plugin>"))
     gains = {"shoulder": {"p": 1000.0, "i": 500.0, "d": 20.0, "i_clamp": 5.0, "antiwindup": True},
              "elbow": {"p": 500.0, "i": 250.0, "d": 5.0, "i_clamp": 2.0, "antiwindup": True}}
-    params = dict(load_yaml(os.path.join(ROBOTS, "config", "arm_position.yaml")))
     # Noetic reads the gains under the robot namespace (here the model name); legacyModeNS at the root.
-    params["/gazebo_ros_control/pid_gains" if legacy else "/arm/gazebo_ros_control/pid_gains"] = gains
-    sim, spawned, plugin = simulate(urdf, params, "arm")
+    gains_name = "/gazebo_ros_control/pid_gains" if legacy else "/arm/gazebo_ros_control/pid_gains"
+    sim, spawned, plugin = simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", "arm_position.yaml")), "arm",
+                                    {gains_name: gains})
     try:
         assert all(joint.pid is not None for joint in plugin.hw.joints.values())
         manager = plugin.manager

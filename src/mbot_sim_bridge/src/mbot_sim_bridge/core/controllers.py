@@ -15,8 +15,8 @@ import threading
 from typing import Dict, List, Optional, Sequence
 
 from .log import get_logger, warn_once
+from .robot_model import RobotModel
 from .ros_control import (EFFORT, JOINT_STATE, POSITION, VELOCITY, ControllerInitError, LoadContext, Pid, RobotHWSim,
-                          UrdfInfo,
                           clamp, shortest_angular_distance, shortest_angular_distance_with_limits)
 
 _logger = get_logger(__name__)
@@ -341,7 +341,7 @@ class DiffDriveController(Controller):
         self.last_publish = 0.0
         self.limited = (0.0, 0.0)
 
-    def _geometry_from_urdf(self, urdf: Optional[UrdfInfo], left: str, right: str):
+    def _geometry_from_urdf(self, urdf: Optional[RobotModel], left: str, right: str):
         if self.wheel_separation is not None and self.wheel_radius is not None:
             return
         if urdf is None:
@@ -351,16 +351,16 @@ class DiffDriveController(Controller):
             if joint is None:
                 raise ControllerInitError(f"{joint_name} couldn't be retrieved from model description")
         if self.wheel_separation is None:
-            self.wheel_separation = math.dist(left_joint.origin_xyz, right_joint.origin_xyz)
+            self.wheel_separation = math.dist(left_joint.origin.position, right_joint.origin.position)
         if self.wheel_radius is None:
-            collision = urdf.link_collision.get(left_joint.child)
-            if collision is None:
+            wheel = urdf.links[left_joint.child]
+            if not wheel.collision_kinds:
                 raise ControllerInitError(f"Link {left_joint.child} does not have collision description. Add collision "
                                           f"description for link to urdf.\nCouldn't retrieve {left} wheel radius")
-            if collision[0] not in ("cylinder", "sphere") or collision[1] is None:
+            if wheel.collision_kinds[0] not in ("cylinder", "sphere") or wheel.collision_radii[0] is None:
                 raise ControllerInitError(f"Wheel link {left_joint.child} is NOT modeled as a cylinder or "
                                           f"sphere!\nCouldn't retrieve {left} wheel radius")
-            self.wheel_radius = collision[1]
+            self.wheel_radius = wheel.collision_radii[0]
 
     def wheel_params(self):
         return (self.wheel_separation_multiplier * self.wheel_separation,
@@ -518,15 +518,14 @@ def _position_error(joint_type: str, current: float, target: float, lower: float
 class _UrdfJointLimits:
     """The URDF joint a PID position controller needs: its type and position limits."""
 
-    def __init__(self, urdf: Optional[UrdfInfo], joint: str):
+    def __init__(self, urdf: Optional[RobotModel], joint: str):
         if urdf is None:
             raise ControllerInitError("Failed to parse urdf file")
         urdf_joint = urdf.joints.get(joint)
         if urdf_joint is None:
             raise ControllerInitError(f"Could not find joint '{joint}' in urdf")
         self.type = urdf_joint.type
-        limit = urdf_joint.limit or {}
-        self.lower, self.upper = limit.get("lower", 0.0), limit.get("upper", 0.0)
+        self.lower, self.upper = (urdf_joint.lower, urdf_joint.upper) if urdf_joint.has_limit else (0.0, 0.0)
 
     def enforce(self, command: float) -> float:
         if self.type in ("revolute", "prismatic"):

@@ -10,14 +10,15 @@ The controllers' messages are published from ``update(now)``, which the Simulati
 (``timer`` is due whenever a running controller's publish time has come), so none is stamped ahead of the
 clock; their control runs in ``on_step``.
 """
-from typing import Dict, List, Optional
+from typing import List
 
 from .controllers import CORE_CONTROLLERS
 from .log import get_logger, warn_once
+from .parameters import absolute_name
 from .params import Param
 from .plugin import Plugin
-from .robot_model import parse_robot
-from .ros_control import ControllerManager, RobotHWSim, UrdfInfo, parse_transmissions
+from .robot_model import RobotModel, parse_robot
+from .ros_control import ControllerManager, RobotHWSim, parse_transmissions
 from .xml_values import XmlDocument
 
 _logger = get_logger(__name__)
@@ -65,6 +66,8 @@ class RosControl(Plugin):
     GAZEBO_CLASS = "GazeboRosControlPlugin"
     PARAMS = GAZEBO_ROS_CONTROL_PARAMS
     needs_every_step = True
+    # Controller type -> class; the ROS plugin's classes add the controllers' topics.
+    CONTROLLERS = CORE_CONTROLLERS
 
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
@@ -81,25 +84,26 @@ class RosControl(Plugin):
         elif self.control_period > step + _EPSILON:
             _logger.warning(f"{self.label}: Desired controller update period ({self.control_period} s) is slower than "
                             f"the gazebo simulation period ({step} s).")
-        urdf_text, source = self.robot_description(params["robotParam"])
-        model = parse_robot(urdf_text, source) if urdf_text is not None else context.robot.model
+        parameters = context.simulation.parameters
+        model = self._robot_description(params["robotParam"])
         document: XmlDocument = model.document
-        transmissions = parse_transmissions(document.root, document.where)
-        self.urdf = UrdfInfo.from_model(model)
+        transmissions = parse_transmissions(model.transmissions, document.where)
+        self.urdf = model
         # Noetic reads the PID gains under the robot namespace; Kinetic's legacyModeNS (true, or absent there)
         # read them at the root. A present legacyModeNS is honoured with its Kinetic meaning.
         # Parameter names are absolute: a relative robotNamespace is relative to the simulator's node ("/").
         base = "/" + self.namespace.strip("/") if self.namespace.strip("/") else ""
         pid_namespace = ("" if params["legacyModeNS"] else base) + "/gazebo_ros_control/pid_gains"
         self.hw = RobotHWSim(context.robot, transmissions, self.urdf, self.label,
-                             self.ros_param(base + "/joint_limits"), self.ros_param(pid_namespace), pid_namespace)
+                             parameters.get(base + "/joint_limits"), parameters.get(pid_namespace), pid_namespace)
         if not self.hw.joints:
             warn_once(_logger, f"{self.label}: the robot has no usable <transmission>; the "
                                "controller manager has no joints")
         self.driven_joints = tuple(self.hw.names)
         self.joint_states_published = tuple(self.hw.names)
-        self.manager = ControllerManager(self.hw, self.controller_class, sorted(CORE_CONTROLLERS),
-                                         self.controller_params, self.namespace,
+        self.manager = ControllerManager(self.hw, self.CONTROLLERS.get, sorted(self.CONTROLLERS),
+                                         lambda name: parameters.get(absolute_name(self.namespace, name)),
+                                         self.namespace,
                                          lambda: context.simulation.sim_time)
         self.timer = _PublishSchedule(self)
         self.publish_now: List = []
@@ -108,19 +112,17 @@ class RosControl(Plugin):
         self.e_stop = False
         self._last_e_stop = False
 
-    # -- hooks the ROS plugin overrides ----------------------------------------------------------------------
-    def robot_description(self, param_name: str):
-        """(URDF text, where it came from), or (None, "") to use the spawned model's own description."""
-        return None, ""
-
-    def ros_param(self, name: str) -> Optional[dict]:
-        return None
-
-    def controller_params(self, name: str) -> Optional[Dict]:
-        return None
-
-    def controller_class(self, controller_type: str) -> Optional[type]:
-        return CORE_CONTROLLERS.get(controller_type)
+    def _robot_description(self, param_name: str) -> RobotModel:
+        """The URDF in ``robotParam``, searched from the robot namespace upwards (NodeHandle::searchParam), with
+        package:// resolved as spawning resolves it; the spawned model's own when there is none."""
+        parameters = self.context.simulation.parameters
+        name = parameters.search(self.namespace, param_name)
+        if name is None:
+            _logger.warning(f"{self.label}: no parameter '{param_name}' from namespace {self.namespace} upwards "
+                            "(gazebo_ros_control would wait for it); using the description the model was spawned "
+                            "from")
+            return self.context.robot.model
+        return parse_robot(self.context.simulation.package_uris(parameters.get(name)), f"parameter {name}")
 
     # -- loop ------------------------------------------------------------------------------------------------
     def load_controller(self, name: str) -> bool:

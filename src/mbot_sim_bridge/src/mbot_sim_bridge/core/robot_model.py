@@ -54,6 +54,8 @@ class Link:
     has_inertial: bool
     mass: float
     collision_kinds: List[str]
+    # Radius of each collision shape that has one (cylinder, sphere), else None; in collision_kinds' order.
+    collision_radii: List[Optional[float]] = field(default_factory=list)
     gazebo: List[ElementTree.Element] = field(default_factory=list)
 
     def gazebo_tag(self, tag: str) -> Optional[str]:
@@ -79,6 +81,8 @@ class Joint:
     upper: float = math.inf
     effort: float = 0.0
     velocity: float = 0.0
+    has_limit: bool = False  # a <limit> element was given
+    has_safety_controller: bool = False
 
     @property
     def movable(self) -> bool:
@@ -139,7 +143,7 @@ def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDo
     lower, upper, effort, velocity = (read_attribute_numbers(limit, name, document, (default,), 1)[0]
                                       for name, default in (("lower", 0.0), ("upper", 0.0), ("effort", 0.0),
                                                             ("velocity", 0.0)))
-    values = {"effort": effort, "velocity": velocity}
+    values = {"effort": effort, "velocity": velocity, "has_limit": True}
     if joint_type != "continuous":
         values.update(lower=lower, upper=upper)
     return values
@@ -198,6 +202,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
                                    read_origin(element, document),
                                    read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
                                    if axis is not None else (1.0, 0.0, 0.0),
+                                   has_safety_controller=element.find("safety_controller") is not None,
                                    **_joint_limits(element, joint_type, document))
 
     children = {joint.child for joint in joints.values()}
@@ -213,8 +218,22 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     transmissions = root.findall("transmission")
     dropped = _drop_massless_moving_links(links, joints, source)
     lumped_into = _lump_fixed_links(roots[0], links, joints)
-    return RobotModel(name, roots[0], links, joints, plugins, lumped_into,
-                      _pybullet_urdf(root, links, dropped, document, source), transmissions, document)
+    pybullet_urdf = _pybullet_urdf(root, links, dropped, document, source)
+    _read_collision_radii(root, links, document)
+    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, pybullet_urdf, transmissions, document)
+
+
+def _read_collision_radii(root: ElementTree.Element, links: Dict[str, Link], document: XmlDocument):
+    """Each link's collision radii (a wheel's, for diff_drive_controller), once the shapes have been checked."""
+    for element in root.findall("link"):
+        link = links.get(element.get("name"))
+        if link is None:  # dropped as a massless moving link
+            continue
+        shapes = [geometry[0] for geometry in (c.find("geometry") for c in element.findall("collision"))
+                  if geometry is not None and len(geometry)]
+        link.collision_radii = [
+            read_attribute_numbers(shape, "radius", document, (0.0,), 1)[0] if shape.get("radius") is not None
+            else None for shape in shapes]
 
 
 def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:

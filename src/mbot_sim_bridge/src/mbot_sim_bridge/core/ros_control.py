@@ -21,7 +21,8 @@ from xml.etree import ElementTree
 
 from .errors import ConfigError
 from .log import get_logger, info_once, warn_once
-from .robot_model import RobotModel
+from .robot_model import Joint, RobotModel
+from .xml_values import parse_float
 
 _logger = get_logger(__name__)
 
@@ -52,14 +53,16 @@ def _interfaces(element: ElementTree.Element) -> List[str]:
     return [(child.text or "").strip() for child in element.findall("hardwareInterface") if (child.text or "").strip()]
 
 
-def parse_transmissions(root: ElementTree.Element, where: Callable[[ElementTree.Element], str]) -> List[Transmission]:
-    """Every ``<transmission>`` of a URDF, as transmission_interface's parser reads them.
+def parse_transmissions(elements: Sequence[ElementTree.Element],
+                        where: Callable[[ElementTree.Element], str]) -> List[Transmission]:
+    """A URDF's ``<transmission>`` elements (``RobotModel.transmissions``), as transmission_interface's parser
+    reads them.
 
     Like upstream, a transmission without a name, type, joint or actuator is skipped with an error message;
     a bad ``mechanicalReduction`` is a ConfigError (the simple transmission loader would refuse it).
     """
     transmissions = []
-    for element in root.findall("transmission"):
+    for element in elements:
         name = element.get("name")
         type_element = element.find("type")
         kind = (type_element.text or "").strip() if type_element is not None else ""
@@ -70,7 +73,7 @@ def parse_transmissions(root: ElementTree.Element, where: Callable[[ElementTree.
             value = None
             if reduction is not None:
                 try:
-                    value = float((reduction.text or "").strip())
+                    value = parse_float(reduction.text or "")
                 except ValueError:
                     raise ConfigError(f"{where(reduction)}: transmission '{name}': <mechanicalReduction> "
                                       f"'{(reduction.text or '').strip()}' is not a number") from None
@@ -107,60 +110,18 @@ class JointLimits:
     angle_wraparound: bool = False
 
 
-@dataclass
-class UrdfJoint:
-    """What ros_control reads of a URDF joint: type, <limit>, <safety_controller>, origin, child link."""
-    name: str
-    type: str
-    limit: Optional[Dict[str, float]]
-    has_safety_controller: bool
-    origin_xyz: Tuple[float, float, float]
-    child: str
-
-
-@dataclass
-class UrdfInfo:
-    joints: Dict[str, UrdfJoint]
-    # First <collision> geometry of each link: (tag, radius) for cylinders and spheres, (tag, None) otherwise.
-    link_collision: Dict[str, Optional[Tuple[str, Optional[float]]]]
-
-    @classmethod
-    def from_model(cls, model: RobotModel) -> "UrdfInfo":
-        root = model.document.root
-        joints = {}
-        for element in root.findall("joint"):
-            joint = model.joints.get(element.get("name"))
-            if joint is None:
-                continue
-            limit = element.find("limit")
-            values = None
-            if limit is not None:
-                values = {key: float(limit.get(key, "0")) for key in ("lower", "upper", "effort", "velocity")}
-            joints[joint.name] = UrdfJoint(joint.name, joint.type, values,
-                                           element.find("safety_controller") is not None,
-                                           tuple(joint.origin.position), joint.child)
-        collisions = {}
-        for element in root.findall("link"):
-            collision = element.find("collision")
-            geometry = collision.find("geometry") if collision is not None else None
-            shape = geometry[0] if geometry is not None and len(geometry) else None
-            radius = float(shape.get("radius")) if shape is not None and shape.get("radius") is not None else None
-            collisions[element.get("name")] = (shape.tag, radius) if shape is not None else None
-        return cls(joints, collisions)
-
-
-def urdf_joint_limits(joint: Optional[UrdfJoint]) -> Optional[JointLimits]:
+def urdf_joint_limits(joint: Optional[Joint]) -> Optional[JointLimits]:
     """joint_limits_interface::getJointLimits(urdf joint): None when the joint has no <limit>."""
-    if joint is None or joint.limit is None:
+    if joint is None or not joint.has_limit:
         return None
     limits = JointLimits()
     limits.has_position_limits = joint.type in ("revolute", "prismatic")
     if limits.has_position_limits:
-        limits.min_position, limits.max_position = joint.limit["lower"], joint.limit["upper"]
+        limits.min_position, limits.max_position = joint.lower, joint.upper
     elif joint.type == "continuous":
         limits.angle_wraparound = True
-    limits.has_velocity_limits, limits.max_velocity = True, joint.limit["velocity"]
-    limits.has_effort_limits, limits.max_effort = True, joint.limit["effort"]
+    limits.has_velocity_limits, limits.max_velocity = True, joint.velocity
+    limits.has_effort_limits, limits.max_effort = True, joint.effort
     return limits
 
 
@@ -304,7 +265,7 @@ class SimJoint:
 class RobotHWSim:
     """gazebo_ros_control::DefaultRobotHWSim over a SpawnedRobot (``robot``: joint_state, set_joint_*)."""
 
-    def __init__(self, robot, transmissions: Sequence[Transmission], urdf: UrdfInfo, label: str,
+    def __init__(self, robot, transmissions: Sequence[Transmission], urdf: RobotModel, label: str,
                  limit_params: Optional[dict] = None, pid_params: Optional[dict] = None, pid_namespace: str = ""):
         self.robot = robot
         self.label = label
@@ -503,7 +464,7 @@ class ControllerInitError(Exception):
 class LoadContext:
     """What a controller gets besides its parameters: the robot's URDF (None if it could not be read) and its
     parameter namespace (for messages)."""
-    urdf: Optional[UrdfInfo]
+    urdf: Optional[RobotModel]
     namespace: str
     clock: Callable[[], float]  # the sim time (s), readable from any thread
 

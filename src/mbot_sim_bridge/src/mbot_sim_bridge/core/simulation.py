@@ -19,6 +19,7 @@ from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose
 from .joint_states import JointStatePublisher
 from .log import get_logger, warn_once
+from .parameters import Parameters
 from .plugin import Plugin, PluginContext
 from .plugin_table import filename_of
 from .robot_model import RobotModel
@@ -50,11 +51,16 @@ class SpawnedModel:
 
 class Simulation:
     def __init__(self, world: WorldDescription, registry: Mapping[str, type], seed: int = 0,
-                 connection_mode: int = pybullet.DIRECT, joint_state_rate: float = 100.0):
+                 connection_mode: int = pybullet.DIRECT, joint_state_rate: float = 100.0,
+                 parameters: Optional[Parameters] = None, package_uris: Callable[[str], str] = str):
+        """``parameters``: what plugins read from the parameter server (gazebo_ros_control, tf_prefix);
+        ``package_uris``: resolves package:// in a robot description read from there, as spawning does."""
         self.world = world  # the description the simulation was loaded from
         self.engine = Engine(world.physics, connection_mode)
         self.viewer = Viewer(self.engine) if connection_mode == pybullet.GUI else None
         self.registry = registry
+        self.parameters = parameters if parameters is not None else Parameters()
+        self.package_uris = package_uris
         self.seed = seed
         self.joint_state_rate = joint_state_rate
         self.paused = False

@@ -34,15 +34,12 @@ def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
     return rospy.names.ns_join(namespace or "/", name)
 
 
-def tf_prefix(namespace: Optional[str]) -> str:
+def tf_prefix(plugin, namespace: Optional[str]) -> str:
     """tf::getPrefixParam as a plugin's NodeHandle in ``namespace`` does it: the nearest ``tf_prefix`` parameter
     searched upwards from the namespace (how multi-robot launch files keep robots' frames apart), or ""."""
-    parts = [part for part in (namespace or "/").split("/") if part]
-    for depth in range(len(parts), -1, -1):
-        name = "/" + "/".join(parts[:depth] + ["tf_prefix"])
-        if rospy.has_param(name):
-            return str(rospy.get_param(name))
-    return ""
+    parameters = plugin.context.simulation.parameters
+    name = parameters.search(namespace or "/", "tf_prefix")
+    return str(parameters.get(name)) if name else ""
 
 
 def resolve_frame(frame: str, prefix: str = "") -> str:

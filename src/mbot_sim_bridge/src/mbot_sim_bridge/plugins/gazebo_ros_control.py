@@ -24,10 +24,11 @@ _BASE_CLASS = "controller_interface::ControllerBase"
 
 
 class GazeboRosControl(RosControl):
+    CONTROLLERS = ROS_CONTROLLERS
+
     def __init__(self, context, element, sensor=None):
         self._services_lock = threading.Lock()
         super().__init__(context, element, sensor)
-        self.manager.types = sorted(ROS_CONTROLLERS)
         prefix = resolve_in_namespace(self.namespace, "controller_manager") + "/"
         self.e_stop_subscriber = None
         if self.params["eStopTopic"]:
@@ -44,30 +45,6 @@ class GazeboRosControl(RosControl):
         joints = ", ".join(f"{name}: {joint.interface}" for name, joint in self.hw.joints.items())
         rospy.loginfo(f"{self.label}: controller manager in namespace {self.namespace}: {len(self.hw.joints)} joints "
                       f"({joints}), control period {self.control_period:.4f} s")
-
-    # -- hooks -------------------------------------------------------------------------------------------
-    def robot_description(self, param_name):
-        """The URDF in ``robotParam``, searched from the robot namespace upwards as NodeHandle::searchParam."""
-        namespace = self.namespace.strip("/")
-        parts = namespace.split("/") if namespace else []
-        for depth in range(len(parts), -1, -1):
-            name = "/" + "/".join(parts[:depth] + [param_name.lstrip("/")])
-            if param_name.startswith("/"):
-                name = param_name
-            if rospy.has_param(name):
-                return rospy.get_param(name), f"parameter {name}"
-        rospy.logwarn(f"{self.label}: no parameter '{param_name}' from namespace {self.namespace} upwards "
-                      "(gazebo_ros_control would wait for it); using the description the model was spawned from")
-        return None, ""
-
-    def ros_param(self, name):
-        return rospy.get_param(name, None)
-
-    def controller_params(self, name):
-        return rospy.get_param(resolve_in_namespace(self.namespace, name), None)
-
-    def controller_class(self, controller_type):
-        return ROS_CONTROLLERS.get(controller_type)
 
     # -- topics ------------------------------------------------------------------------------------------
     def _on_e_stop(self, message: Bool):

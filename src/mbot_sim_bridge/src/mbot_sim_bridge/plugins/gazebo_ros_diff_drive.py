@@ -14,7 +14,7 @@ class GazeboRosDiffDrive(DiffDrive):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         params = self.params
-        prefix = tf_prefix(self.namespace)
+        prefix = tf_prefix(self, self.namespace)
         self.odom_frame = resolve_frame(params["odometryFrame"], prefix)
         self.base_frame = resolve_frame(params["robotBaseFrame"], prefix)
         self.publish_odom_tf = params["publishTf"] and params["publishOdomTF"]

@@ -13,7 +13,7 @@ class GazeboRosLaser(RaySensor):
         namespace = sensor_namespace(self)
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), LaserScan)
         self.message = LaserScan()
-        self.message.header.frame_id = resolve_frame(self.params["frameName"], tf_prefix(namespace))
+        self.message.header.frame_id = resolve_frame(self.params["frameName"], tf_prefix(self, namespace))
         self.message.angle_min, self.message.angle_max = config.min_angle, config.max_angle
         self.message.angle_increment = config.angle_increment
         self.message.range_min, self.message.range_max = config.range_min, config.range_max
