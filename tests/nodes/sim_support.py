@@ -45,10 +45,23 @@ def roll_pitch_of(orientation):
     return roll, pitch
 
 
-class Simulator:
-    """The bridge seen through gazebo_ros's services, and the robot through /cmd_vel."""
+def motion_between(start, end):
+    """(speed along the start heading, yaw rate) between two ground truths of ``Simulator.truth()``."""
+    (t0, pose0, twist0), (t1, pose1, twist1) = start, end
+    dt = t1 - t0
+    heading = yaw_of(pose0.orientation)
+    dx, dy = pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y
+    turned = math.remainder(yaw_of(pose1.orientation) - heading, 2 * math.pi)
+    # A loaded machine may answer seconds of sim time late, so the poses alone hide whole turns: the
+    # physics' own angular velocity counts them.
+    whole_turns = round((0.5 * (twist0.angular.z + twist1.angular.z) * dt - turned) / (2 * math.pi))
+    return (dx * math.cos(heading) + dy * math.sin(heading)) / dt, (turned + 2 * math.pi * whole_turns) / dt
 
-    def __init__(self, model="mbot"):
+
+class Simulator:
+    """The bridge seen through gazebo_ros's services, and the robot through /cmd_vel (None: a robot without)."""
+
+    def __init__(self, model="mbot", cmd_vel="/cmd_vel"):
         self.model = model
         for service in ("get_model_state", "get_world_properties", "reset_world", "pause_physics",
                         "unpause_physics", "reset_simulation"):
@@ -60,8 +73,9 @@ class Simulator:
         self.pause = rospy.ServiceProxy("/gazebo/pause_physics", Empty)
         self.unpause = rospy.ServiceProxy("/gazebo/unpause_physics", Empty)
         wait_for(lambda: model in self.world_properties().model_names, what=f"model '{model}' to be spawned")
-        self.cmd_vel = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
-        wait_for(lambda: self.cmd_vel.get_num_connections() > 0, what="the simulator to subscribe /cmd_vel")
+        if cmd_vel:
+            self.cmd_vel = rospy.Publisher(cmd_vel, Twist, queue_size=1, latch=True)
+            wait_for(lambda: self.cmd_vel.get_num_connections() > 0, what=f"the simulator to subscribe {cmd_vel}")
 
     def truth(self):
         """(sim time, pose, twist) of the model, measured in one step of the simulator."""

@@ -11,7 +11,7 @@ import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
-from sim_support import Simulator, print_figures, roll_pitch_of, wait_for, yaw_of
+from sim_support import Simulator, motion_between, print_figures, roll_pitch_of, wait_for
 
 SETTLE_SECONDS = 2.0  # a steady command for this long before measuring
 MEASURE_SECONDS = 1.0
@@ -33,13 +33,10 @@ class DriveTracking(unittest.TestCase):
         """Reset, command, settle, then measure over a window: (speed along heading, yaw rate, worst tilt, z)."""
         self.sim.reset_world()
         self.sim.command(linear, angular)
-        t0, pose0, _ = self.sim.wait_sim_time(SETTLE_SECONDS)
-        t1, pose1, _ = self.sim.wait_sim_time(MEASURE_SECONDS)
-        dt = t1 - t0
-        heading = yaw_of(pose0.orientation)
-        dx, dy = pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y
-        speed = (dx * math.cos(heading) + dy * math.sin(heading)) / dt
-        yaw_rate = math.remainder(yaw_of(pose1.orientation) - heading, 2 * math.pi) / dt
+        start = self.sim.wait_sim_time(SETTLE_SECONDS)
+        end = self.sim.wait_sim_time(MEASURE_SECONDS)
+        speed, yaw_rate = motion_between(start, end)
+        pose0, pose1 = start[1], end[1]
         tilt = max(abs(a) for pose in (pose0, pose1) for a in roll_pitch_of(pose.orientation))
         z = max(abs(pose0.position.z), abs(pose1.position.z))
         self.sim.command(0.0, 0.0)

@@ -14,38 +14,14 @@ from controller_manager_msgs.srv import (ListControllers, ListControllerTypes, L
                                          SwitchControllerRequest, UnloadController)
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from rosgraph_msgs.msg import Log
-from std_srvs.srv import Empty
 
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, Simulator, controller_states, motion_between, print_figures, wait_for
 
 CONTROLLER = "mobile_base_controller"
 SETTLE_SECONDS = 2.0
 MEASURE_SECONDS = 1.0
 STRICT, BEST_EFFORT = SwitchControllerRequest.STRICT, SwitchControllerRequest.BEST_EFFORT
-
-
-class GroundTruth:
-    """The model's pose from gazebo_ros's services (this robot has no /cmd_vel, which sim_support waits for)."""
-
-    def __init__(self, model="mbot"):
-        self.model = model
-        for service in ("get_model_state", "get_world_properties", "reset_world"):
-            rospy.wait_for_service("/gazebo/" + service, timeout=WALL_TIMEOUT)
-        self.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
-        self.reset_world = rospy.ServiceProxy("/gazebo/reset_world", Empty)
-        properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
-        wait_for(lambda: model in properties().model_names, what=f"model '{model}' to be spawned")
-
-    def truth(self):
-        state = self.get_model_state(self.model, "world")
-        return state.header.stamp.to_sec(), state.pose, state.twist
-
-    def wait_sim_time(self, seconds):
-        start = self.truth()[0]
-        return wait_for(lambda: (lambda truth: truth if truth[0] >= start + seconds else None)(self.truth()),
-                        what=f"{seconds:.1f} s of sim time")
 
 
 class RosControlMbot(unittest.TestCase):
@@ -55,7 +31,7 @@ class RosControlMbot(unittest.TestCase):
         cls.figures = []
         cls.logs = []
         cls.log_subscriber = rospy.Subscriber("/rosout", Log, lambda log: cls.logs.append(log.msg))
-        cls.sim = GroundTruth()
+        cls.sim = Simulator(cmd_vel=None)  # the controller, not the simulator, subscribes its cmd_vel
         services = {"list_controllers": ListControllers, "list_controller_types": ListControllerTypes,
                     "load_controller": LoadController, "unload_controller": UnloadController,
                     "switch_controller": SwitchController}
@@ -100,13 +76,10 @@ class RosControlMbot(unittest.TestCase):
     def steady_motion(self, linear, angular):
         self.sim.reset_world()
         self.command(linear, angular)
-        t0, pose0, _ = self.sim.wait_sim_time(SETTLE_SECONDS)
-        t1, pose1, _ = self.sim.wait_sim_time(MEASURE_SECONDS)
+        start = self.sim.wait_sim_time(SETTLE_SECONDS)
+        end = self.sim.wait_sim_time(MEASURE_SECONDS)
         self.command(0.0, 0.0)
-        heading = yaw_of(pose0.orientation)
-        dx, dy = pose1.position.x - pose0.position.x, pose1.position.y - pose0.position.y
-        return ((dx * math.cos(heading) + dy * math.sin(heading)) / (t1 - t0),
-                math.remainder(yaw_of(pose1.orientation) - heading, 2 * math.pi) / (t1 - t0))
+        return motion_between(start, end)
 
     def test_1_tracks_linear_and_angular_speed(self):
         for linear, angular in ((0.2, 0.0), (-0.2, 0.0), (0.0, 0.5), (0.0, -1.0)):

@@ -53,7 +53,7 @@ def test_gazebo_ros_control_reads_package_meshes_from_robot_description_as_spawn
                      parameters=Parameters({"robot_description": ARM}), package_uris=package_uris)
     try:
         spawned = sim.spawn_robot(parse_robot(package_uris(ARM), "model 'meshy'"), "meshy")
-        plugin = next(plugin for plugin in spawned.plugins if type(plugin).__name__ == "RosControl")
+        plugin = next(plugin for plugin in spawned.plugins if type(plugin).__name__ == "GazeboRosControlPlugin")
         assert list(plugin.hw.joints) == ["swing"]
         limits = plugin.hw.joints["swing"].limits
         assert (limits.min_position, limits.max_position, limits.max_effort) == (-1, 1, 10)

@@ -1,4 +1,4 @@
-"""core/ros_control.py, core/controllers.py, core/gazebo_ros_control.py: transmissions, limits, the PID, the diff
+"""core/ros_control/ and core/gazebo_ros_control.py: transmissions, limits, the PID, the diff
 drive's odometry and speed limiter, the controller manager's state machine and texts, and the mbot and a
 two-joint arm driven through the controllers in the simulation, with no ROS master."""
 import logging
@@ -9,15 +9,17 @@ import threading
 import pytest
 import yaml
 
-from mbot_sim_bridge.core.controllers import DiffDriveOdometry, SpeedLimiter
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.gazebo_ros_control import RosControl
+from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.ros_control import (JointLimits, Pid, apply_limit_params, parse_transmissions,
-                                              shortest_angular_distance_with_limits)
+from mbot_sim_bridge.core.ros_control.angles import shortest_angular_distance_with_limits
+from mbot_sim_bridge.core.ros_control.control_toolbox import Pid
+from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveOdometry, SpeedLimiter
+from mbot_sim_bridge.core.ros_control.joint_limits import JointLimits, apply_limit_params
+from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.core.xml_values import parse_xml
@@ -49,7 +51,7 @@ def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str,
     sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS,
                      parameters=Parameters(tree), package_uris=package_uris)
     spawned = sim.spawn_robot(parse_robot(package_uris(urdf), f"model '{name}'"), name)
-    plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, RosControl))
+    plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, GazeboRosControlPlugin))
     return sim, spawned, plugin
 
 

@@ -12,18 +12,19 @@ clock; their control runs in ``on_step``.
 """
 from typing import List
 
-from .controllers import CORE_CONTROLLERS
 from .log import get_logger, warn_once
 from .parameters import absolute_name
 from .params import Param
 from .plugin import Plugin
 from .robot_model import RobotModel, parse_robot
-from .ros_control import ControllerManager, RobotHWSim, parse_transmissions
+from .ros_control import CORE_CONTROLLERS
+from .ros_control.controller_manager import ControllerManager
+from .ros_control.robot_hw_sim import ROBOT_HW_SIMS
+from .ros_control.transmissions import parse_transmissions
 from .xml_values import XmlDocument
 
 _logger = get_logger(__name__)
 
-DEFAULT_ROBOT_HW_SIM = "gazebo_ros_control/DefaultRobotHWSim"
 # controlPeriod equal to the step, to within this, counts as the step (sim time is a multiple of it).
 _EPSILON = 1e-9
 
@@ -34,8 +35,8 @@ GAZEBO_ROS_CONTROL_PARAMS = (
           warn_if_missing=False),
     Param("controlPeriod", float, 0.0, "controller update period (s); absent = the physics step",
           warn_if_missing=False, minimum=0.0),
-    Param("robotSimType", str, DEFAULT_ROBOT_HW_SIM, "robot hardware simulation; only the default one",
-          warn_if_missing=False, choices=(DEFAULT_ROBOT_HW_SIM,)),
+    Param("robotSimType", str, "gazebo_ros_control/DefaultRobotHWSim", "robot hardware simulation",
+          warn_if_missing=False, choices=tuple(ROBOT_HW_SIMS)),
     Param("legacyModeNS", bool, False, "Kinetic's absolute /gazebo_ros_control/pid_gains namespace when true "
           "(see README)", warn_if_missing=False),
     Param("eStopTopic", str, "", "std_msgs/Bool topic: true stops every joint, false restarts the controllers",
@@ -46,7 +47,7 @@ GAZEBO_ROS_CONTROL_PARAMS = (
 class _PublishSchedule:
     """The plugin's ``timer``: due when any running controller has something to publish."""
 
-    def __init__(self, plugin: "RosControl"):
+    def __init__(self, plugin: "GazeboRosControlPlugin"):
         self.plugin = plugin
 
     def due(self, now: float) -> bool:
@@ -62,7 +63,7 @@ class _PublishSchedule:
         pass
 
 
-class RosControl(Plugin):
+class GazeboRosControlPlugin(Plugin):
     GAZEBO_CLASS = "GazeboRosControlPlugin"
     PARAMS = GAZEBO_ROS_CONTROL_PARAMS
     needs_every_step = True
@@ -94,8 +95,9 @@ class RosControl(Plugin):
         # Parameter names are absolute: a relative robotNamespace is relative to the simulator's node ("/").
         base = "/" + self.namespace.strip("/") if self.namespace.strip("/") else ""
         pid_namespace = ("" if params["legacyModeNS"] else base) + "/gazebo_ros_control/pid_gains"
-        self.hw = RobotHWSim(context.robot, transmissions, self.urdf, self.label,
-                             parameters.get(base + "/joint_limits"), parameters.get(pid_namespace), pid_namespace)
+        self.hw = ROBOT_HW_SIMS[params["robotSimType"]](
+            context.robot, transmissions, self.urdf, self.label, parameters.get(base + "/joint_limits"),
+            parameters.get(pid_namespace), pid_namespace)
         if not self.hw.joints:
             warn_once(_logger, f"{self.label}: the robot has no usable <transmission>; the "
                                "controller manager has no joints")
@@ -134,14 +136,14 @@ class RosControl(Plugin):
         period = now - self.last_update
         if period >= self.control_period - _EPSILON:
             self.last_update = now
-            self.hw.read()
+            self.hw.read_sim()
             reset = False
             if self.e_stop:
                 self._last_e_stop = True
             elif self._last_e_stop:
                 reset, self._last_e_stop = True, False
             self.manager.update(now, period, reset)
-        self.hw.write(now - self.last_write)
+        self.hw.write_sim(now - self.last_write)
         self.last_write = now
 
     def update(self, now: float):

@@ -7,14 +7,14 @@ from typing import Dict
 
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
-from .gazebo_ros_control import RosControl
+from .gazebo_ros_control import GazeboRosControlPlugin
 from .imu import ImuModelPlugin, ImuSensor
 from .joint_states import JointStatePublisher
 from .lidar import RaySensor
 from .p3d import P3D
 
 CORE_PLUGINS: Dict[str, type] = {
-    "libgazebo_ros_control.so": RosControl,
+    "libgazebo_ros_control.so": GazeboRosControlPlugin,
     "libgazebo_ros_diff_drive.so": DiffDrive,
     "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
     "libgazebo_ros_laser.so": RaySensor,

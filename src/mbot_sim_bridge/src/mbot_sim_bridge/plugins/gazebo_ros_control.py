@@ -15,7 +15,7 @@ from controller_manager_msgs.srv import (ListControllers, ListControllersRespons
                                          UnloadControllerResponse)
 from std_msgs.msg import Bool
 
-from ..core.gazebo_ros_control import RosControl
+from ..core.gazebo_ros_control import GazeboRosControlPlugin
 from ..subscriptions import TrackedSubscriber
 from . import resolve_in_namespace, ros_time
 from .ros_controllers import ROS_CONTROLLERS
@@ -23,7 +23,7 @@ from .ros_controllers import ROS_CONTROLLERS
 _BASE_CLASS = "controller_interface::ControllerBase"
 
 
-class GazeboRosControl(RosControl):
+class GazeboRosControl(GazeboRosControlPlugin):
     CONTROLLERS = ROS_CONTROLLERS
 
     def __init__(self, context, element, sensor=None):

@@ -13,7 +13,9 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 from tf2_msgs.msg import TFMessage
 
-from ..core.controllers import CORE_CONTROLLERS, DiffDriveController, JointStateController
+from ..core.ros_control import CORE_CONTROLLERS
+from ..core.ros_control.diff_drive_controller import DiffDriveController
+from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.log import get_logger, warn_once
 from ..subscriptions import TrackedSubscriber
 from . import loop_publisher, resolve_frame, resolve_in_namespace

@@ -1,0 +1,42 @@
+"""ros_control in the simulator, without ROS, along upstream's package lines (ros_control 0.20, ros_controllers and
+gazebo_ros_control of Noetic). The ROS layer (``plugins/gazebo_ros_control.py``, ``plugins/ros_controllers.py``)
+adds services and topics.
+
+- ``hardware_interface``: the interface names; ``transmissions``: the ``<transmission>`` parser;
+  ``joint_limits``: limits from the URDF and the parameters; ``angles`` and ``control_toolbox`` (Pid);
+- ``robot_hw_sim``: the robot hardware simulation (DefaultRobotHWSim); ``controller_manager``;
+- the controllers, a module per package: ``controller_interface`` (the base), ``joint_state_controller``,
+  ``diff_drive_controller``, ``forward_command_controller`` (position_/velocity_/effort_controllers' forward
+  ones), ``pid_controllers`` (their PID ones). Adding a controller is a module and a line in ``CORE_CONTROLLERS``.
+"""
+from typing import Dict
+
+from .diff_drive_controller import DiffDriveController
+from .forward_command_controller import ForwardCommandController, ForwardJointGroupCommandController, forward_type
+from .hardware_interface import EFFORT, POSITION, VELOCITY
+from .joint_state_controller import JointStateController
+from .pid_controllers import EffortGroupPositionController, EffortVelocityController, PidPositionController
+
+# Controller type string -> core class. The ROS layer has the same keys with its subclasses.
+CORE_CONTROLLERS: Dict[str, type] = {
+    "joint_state_controller/JointStateController": JointStateController,
+    "diff_drive_controller/DiffDriveController": DiffDriveController,
+    "position_controllers/JointPositionController":
+        forward_type(ForwardCommandController, POSITION, True, "PositionJointPositionController"),
+    "position_controllers/JointGroupPositionController":
+        forward_type(ForwardJointGroupCommandController, POSITION, True, "PositionJointGroupPositionController"),
+    "velocity_controllers/JointVelocityController":
+        forward_type(ForwardCommandController, VELOCITY, False, "VelocityJointVelocityController"),
+    "velocity_controllers/JointGroupVelocityController":
+        forward_type(ForwardJointGroupCommandController, VELOCITY, False, "VelocityJointGroupVelocityController"),
+    "velocity_controllers/JointPositionController":
+        type("VelocityJointPositionController", (PidPositionController,), {"INTERFACE": VELOCITY}),
+    "effort_controllers/JointEffortController":
+        forward_type(ForwardCommandController, EFFORT, False, "EffortJointEffortController"),
+    "effort_controllers/JointGroupEffortController":
+        forward_type(ForwardJointGroupCommandController, EFFORT, False, "EffortJointGroupEffortController"),
+    "effort_controllers/JointPositionController":
+        type("EffortJointPositionController", (PidPositionController,), {"INTERFACE": EFFORT}),
+    "effort_controllers/JointVelocityController": EffortVelocityController,
+    "effort_controllers/JointGroupPositionController": EffortGroupPositionController,
+}

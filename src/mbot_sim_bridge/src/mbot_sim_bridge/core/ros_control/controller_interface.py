@@ -1,0 +1,76 @@
+"""controller_interface::Controller<T>, and reading a controller's parameters as NodeHandle::param does."""
+from typing import List
+
+from ..log import get_logger, warn_once
+from .controller_manager import LoadContext
+from .hardware_interface import JOINT_STATE
+from .robot_hw_sim import DefaultRobotHWSim
+
+_logger = get_logger(__name__)
+
+
+_MISSING = object()
+
+
+def param(params: dict, path: str, default=_MISSING, kind: type = float, where: str = ""):
+    """A controller parameter by its slash path ("linear/x/max_velocity"), as NodeHandle::param reads it:
+    ints are accepted for doubles; a value of the wrong type keeps the default, with a warning."""
+    value = params
+    for key in path.split("/"):
+        if not isinstance(value, dict) or key not in value:
+            return None if default is _MISSING else default
+        value = value[key]
+    if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    if kind is int and isinstance(value, int) and not isinstance(value, bool):
+        return value
+    if isinstance(value, kind):
+        return value
+    warn_once(_logger, f"{where}: parameter '{path}' is {value!r}, not a {kind.__name__}; using {default!r}")
+    return None if default is _MISSING else default
+
+
+class Controller:
+    """controller_interface::Controller<T>: the state machine and the claimed resources."""
+
+    INTERFACE = JOINT_STATE
+
+    def __init__(self, name: str, hw: DefaultRobotHWSim, params: dict, context: "LoadContext"):
+        self.name = name
+        self.hw = hw
+        self.params = params
+        self.state = "initialized"
+        self.claimed: List[str] = []
+
+    def handle(self, joint: str):
+        handle = self.hw.handle(joint, self.INTERFACE)
+        if self.INTERFACE != JOINT_STATE and joint not in self.claimed:
+            self.claimed.append(joint)
+        return handle
+
+    def start_request(self, now: float):
+        self.starting(now)
+        self.state = "running"
+
+    def stop_request(self, now: float):
+        self.stopping(now)
+        self.state = "stopped"
+
+    def starting(self, now: float):
+        pass
+
+    def stopping(self, now: float):
+        pass
+
+    def update(self, now: float, period: float):
+        pass
+
+    def publish_due(self, now: float) -> bool:
+        """Whether the ROS layer has something to publish now (the bridge publishes after /clock)."""
+        return False
+
+    def restart_clock(self, now: float):
+        """Sim time was reset: start the publish and timeout clocks again from ``now``."""
+
+    def close(self):
+        pass

@@ -1,0 +1,129 @@
+"""The PID controllers of effort_controllers and velocity_controllers: JointPositionController,
+JointVelocityController, JointGroupPositionController (control_toolbox's Pid from ``pid/p i d i_clamp``)."""
+from typing import Optional
+
+from ..robot_model import RobotModel
+from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
+from .control_toolbox import Pid
+from .controller_manager import ControllerInitError
+from .hardware_interface import EFFORT
+from .controller_interface import Controller, param
+from .forward_command_controller import ForwardJointGroupCommandController, joint_name_param
+
+def _position_error(joint_type: str, current: float, target: float, lower: float, upper: float) -> float:
+    if joint_type == "revolute":
+        return shortest_angular_distance_with_limits(current, target, lower, upper)
+    if joint_type == "continuous":
+        return shortest_angular_distance(current, target)
+    return target - current
+
+
+class _UrdfJointLimits:
+    """The URDF joint a PID position controller needs: its type and position limits."""
+
+    def __init__(self, urdf: Optional[RobotModel], joint: str):
+        if urdf is None:
+            raise ControllerInitError("Failed to parse urdf file")
+        urdf_joint = urdf.joints.get(joint)
+        if urdf_joint is None:
+            raise ControllerInitError(f"Could not find joint '{joint}' in urdf")
+        self.type = urdf_joint.type
+        self.lower, self.upper = (urdf_joint.lower, urdf_joint.upper) if urdf_joint.has_limit else (0.0, 0.0)
+
+    def enforce(self, command: float) -> float:
+        if self.type in ("revolute", "prismatic"):
+            if command > self.upper:
+                return self.upper
+            if command < self.lower:
+                return self.lower
+        return command
+
+
+def _pid(params: dict, key: str, namespace: str) -> Pid:
+    pid = Pid.from_params(param(params, key, None, dict), namespace + "/" + key)
+    if pid is None:
+        raise ControllerInitError("")  # Pid.from_params has said why
+    return pid
+
+
+class PidPositionController(Controller):
+    """effort_controllers/JointPositionController (INTERFACE EFFORT) and velocity_controllers/
+    JointPositionController (INTERFACE VELOCITY): PID on the position error, output as the joint's command."""
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        joint = joint_name_param(params, self.namespace)
+        self.pid = _pid(params, "pid", self.namespace)
+        self.joint = self.handle(joint)
+        self.urdf = _UrdfJointLimits(context.urdf, joint)
+        self.target = 0.0
+        self.target_velocity = None
+        self.error = self.output = 0.0
+
+    def set_command(self, position: float, velocity: Optional[float] = None):
+        self.target, self.target_velocity = position, velocity
+
+    def starting(self, now):
+        self.target, self.target_velocity = self.urdf.enforce(self.joint.position), None
+        self.pid.reset()
+
+    def update(self, now, period):
+        target = self.urdf.enforce(self.target)
+        self.error = _position_error(self.urdf.type, self.joint.position, target, self.urdf.lower, self.urdf.upper)
+        velocity_error = None if self.target_velocity is None else self.target_velocity - self.joint.velocity
+        self.output = self.pid.compute(self.error, period, velocity_error)
+        self.joint.command = self.output
+
+
+class EffortVelocityController(Controller):
+    """effort_controllers/JointVelocityController: PID on the velocity error, output as effort."""
+
+    INTERFACE = EFFORT
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.namespace = context.namespace
+        self.joint = self.handle(joint_name_param(params, self.namespace))
+        self.pid = _pid(params, "pid", self.namespace)
+        self.target = 0.0
+        self.error = self.output = 0.0
+
+    def set_command(self, velocity: float):
+        self.target = velocity
+
+    def starting(self, now):
+        self.target = 0.0
+        self.pid.reset()
+
+    def update(self, now, period):
+        self.error = self.target - self.joint.velocity
+        self.output = self.pid.compute(self.error, period)
+        self.joint.command = self.output
+
+
+class EffortGroupPositionController(ForwardJointGroupCommandController):
+    """effort_controllers/JointGroupPositionController: one PID per joint, from ``<joint>/pid``."""
+
+    INTERFACE = EFFORT
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self.urdf = [_UrdfJointLimits(context.urdf, joint) for joint in self.joint_names]
+        self.pids = []
+        for joint in self.joint_names:
+            pid = Pid.from_params(param(params, joint + "/pid", None, dict), self.namespace + "/" + joint + "/pid")
+            if pid is None:
+                raise ControllerInitError(f"Failed to load PID parameters from {joint}/pid")
+            self.pids.append(pid)
+
+    def starting(self, now):
+        self.commands = [limits.enforce(joint.position) for joint, limits in zip(self.joints, self.urdf)]
+        for pid in self.pids:
+            pid.reset()
+
+    def update(self, now, period):
+        for joint, command, limits, pid in zip(self.joints, self.commands, self.urdf, self.pids):
+            target = limits.enforce(command)
+            joint.command = pid.compute(_position_error(limits.type, joint.position, target, limits.lower,
+                                                        limits.upper), period)

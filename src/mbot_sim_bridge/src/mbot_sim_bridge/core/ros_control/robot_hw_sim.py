@@ -1,0 +1,249 @@
+"""gazebo_ros_control's robot hardware simulations, each with upstream's RobotHWSim interface (``init_sim`` is
+the constructor, ``read_sim``, ``write_sim``), by ``<robotSimType>`` in ``ROBOT_HW_SIMS``.
+
+DefaultRobotHWSim: one joint per transmission with its first hardware interface; joint limits
+from the URDF and the ``joint_limits/<joint>`` parameters, enforced as joint_limits_interface's saturation
+handles; ``gazebo_ros_control/pid_gains/<joint>`` turns position and velocity joints into PID-driven effort
+joints; the e-stop."""
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from ..errors import ConfigError
+from ..log import get_logger, info_once, warn_once
+from ..robot_model import RobotModel
+from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
+from .control_toolbox import Pid, clamp
+from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, POSITION, UNBOUNDED_EFFORT, VELOCITY,
+                                 HardwareInterfaceError)
+from .joint_limits import JointLimits, apply_limit_params, urdf_joint_limits
+from .transmissions import Transmission
+
+_logger = get_logger(__name__)
+
+
+@dataclass
+class SimJoint:
+    """One joint of the hardware simulation: the handle controllers read and command."""
+    name: str
+    interface: str  # EFFORT, POSITION or VELOCITY
+    joint_type: str  # URDF type, or inferred from the limits; "" if unknown
+    limits: Optional[JointLimits]
+    pid: Optional[Pid] = None
+    # gazebo_ros_control starts these at 1.0 (position, effort) until the first read.
+    position: float = 1.0
+    velocity: float = 0.0
+    effort: float = 1.0
+    command: float = 0.0
+    previous_command: float = math.nan  # position saturation's memory
+    previous_velocity_command: float = 0.0  # velocity saturation's memory
+    sent: Optional[Tuple[str, float]] = field(default=None, repr=False)  # last motor setting given to the engine
+
+    @property
+    def lower(self) -> float:
+        return self.limits.min_position if self.limits and self.limits.has_position_limits else -math.inf
+
+    @property
+    def upper(self) -> float:
+        return self.limits.max_position if self.limits and self.limits.has_position_limits else math.inf
+
+    @property
+    def effort_limit(self) -> float:
+        return self.limits.max_effort if self.limits and self.limits.has_effort_limits else math.inf
+
+
+class DefaultRobotHWSim:
+    """gazebo_ros_control::DefaultRobotHWSim over a SpawnedRobot (``robot``: joint_state, set_joint_*)."""
+
+    def __init__(self, robot, transmissions: Sequence[Transmission], urdf: RobotModel, label: str,
+                 limit_params: Optional[dict] = None, pid_params: Optional[dict] = None, pid_namespace: str = ""):
+        self.robot = robot
+        self.label = label
+        self.joints: Dict[str, SimJoint] = {}
+        self.e_stop_active = False
+        self._last_e_stop_active = False
+        self._held_positions: Dict[str, float] = {}
+        limit_params, pid_params = limit_params or {}, pid_params or {}
+        for transmission in transmissions:
+            if len(transmission.joints) > 1:
+                _logger.warning(f"{label}: Transmission {transmission.name} has more than one joint. Currently the "
+                                "default robot hardware simulation  interface only supports one.")
+                continue
+            joint_name, interfaces = transmission.joints[0]
+            if not interfaces and transmission.actuators and transmission.actuators[0][1]:
+                interfaces = transmission.actuators[0][1]
+                warn_once(_logger, f"{label}: The <hardware_interface> element of tranmission {transmission.name} "
+                                   "should be nested inside the <joint> element, not <actuator>. The transmission "
+                                   "will be properly loaded, but please update your robot model to remain compatible "
+                                   "with future versions of the plugin.")
+            if not interfaces:
+                _logger.warning(f"{label}: Joint {joint_name} of transmission {transmission.name} does not specify any "
+                                "hardware interface. Not adding it to the robot hardware simulation.")
+                continue
+            if len(interfaces) > 1:
+                _logger.warning(f"{label}: Joint {joint_name} of transmission {transmission.name} specifies multiple "
+                                "hardware interfaces. Currently the default robot hardware simulation interface only "
+                                "supports one. Using the first entry")
+            interface = interfaces[0].replace("hardware_interface/", "", 1)
+            if interface not in (EFFORT, POSITION, VELOCITY):
+                raise ConfigError(f"{label}: No matching hardware interface found for '{interfaces[0]}' while loading "
+                                  f"interfaces for {joint_name}")
+            if interface == interfaces[0]:
+                warn_once(_logger, f"{label}: Deprecated syntax, please prepend 'hardware_interface/' to '{interface}' "
+                                   f"within the <hardwareInterface> tag in joint '{joint_name}'.")
+            if joint_name not in robot.joint_index:
+                raise ConfigError(f'{label}: This robot has a joint named "{joint_name}" which is '
+                                  'not in the gazebo model.')
+            reductions = [value for _, _, value in transmission.actuators if value is not None and value != 1.0]
+            if reductions:
+                info_once(_logger, f"{label}: transmission {transmission.name}: mechanicalReduction {reductions[0]} is "
+                                   "read but, as in gazebo_ros_control's default robot "
+                                   "hardware simulation, not applied")
+            urdf_joint = urdf.joints.get(joint_name)
+            limits = apply_limit_params(urdf_joint_limits(urdf_joint), limit_params.get(joint_name), joint_name)
+            joint_type = urdf_joint.type if urdf_joint is not None else ""
+            if not joint_type and limits is not None:
+                joint_type = ("revolute" if limits.has_position_limits
+                              else "continuous" if limits.angle_wraparound else "prismatic")
+            if urdf_joint is not None and urdf_joint.has_safety_controller:
+                warn_once(_logger, f"{label}: joint '{joint_name}' has a <safety_controller>: soft joint limits are "
+                                   "not simulated; its hard limits are enforced as saturation")
+            self._check_limits(joint_name, interface, limits)
+            pid = None
+            if interface != EFFORT:
+                # Upstream logs "No p gain specified" as an error for every joint without gains; that is the
+                # normal case (the joint is driven directly), so it is said once at INFO here.
+                pid = Pid.from_params(pid_params.get(joint_name), f"{pid_namespace}/{joint_name}", quiet=True)
+                if pid is None:
+                    drive = "position servo" if interface == POSITION else "velocity motor"
+                    info_once(_logger, f"{label}: no {pid_namespace}/{joint_name}/p: joint '{joint_name}' is "
+                                       f"driven directly ({drive})")
+            self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid)
+        self.names = list(self.joints)
+
+    def _check_limits(self, joint: str, interface: str, limits: Optional[JointLimits]):
+        """The saturation handles' constructors refuse limits they cannot enforce (JointLimitsInterfaceException)."""
+        if limits is None:
+            return
+        if interface in (EFFORT, VELOCITY) and not limits.has_velocity_limits:
+            raise ConfigError(f"{self.label}: Cannot enforce limits for joint '{joint}'. It has no "
+                              "velocity limits specification.")
+        if interface == EFFORT and not limits.has_effort_limits:
+            raise ConfigError(f"{self.label}: Cannot enforce limits for joint '{joint}'. It has no "
+                              "efforts limits specification.")
+
+    def handle(self, name: str, interface: str) -> SimJoint:
+        """A command handle (interface EFFORT/POSITION/VELOCITY) or a state handle (JOINT_STATE)."""
+        joint = self.joints.get(name)
+        if joint is None or (interface != JOINT_STATE and joint.interface != interface):
+            raise HardwareInterfaceError(f"Could not find resource '{name}' in '{INTERFACE_TYPES[interface]}'.")
+        return joint
+
+    def names_with(self, interface: str) -> List[str]:
+        return [name for name, joint in self.joints.items() if interface == JOINT_STATE or joint.interface == interface]
+
+    def read_sim(self):
+        """readSim: positions (revolute and continuous unwrapped step by step, as upstream), velocities, efforts."""
+        if not self.names:
+            return
+        for joint, (position, velocity, effort) in zip(self.joints.values(), self.robot.joint_state(self.names)):
+            if joint.joint_type == "prismatic":
+                joint.position = position
+            else:
+                joint.position += shortest_angular_distance(joint.position, position)
+            joint.velocity = velocity
+            joint.effort = effort
+
+    def write_sim(self, period: float):
+        """writeSim: e-stop, limit saturation, then each joint's motor; the engine is told only of changes."""
+        if self.e_stop_active:
+            if not self._last_e_stop_active:
+                self._held_positions = {name: joint.position for name, joint in self.joints.items()}
+                self._last_e_stop_active = True
+        else:
+            self._last_e_stop_active = False
+        for joint in self.joints.values():
+            if joint.interface == POSITION and self.e_stop_active:
+                joint.command = self._held_positions.get(joint.name, joint.position)
+            if joint.limits is not None:
+                self._saturate(joint, period)
+            self._drive(joint, period)
+
+    def _saturate(self, joint: SimJoint, period: float):
+        limits = joint.limits
+        if joint.interface == EFFORT:
+            low, high = -limits.max_effort, limits.max_effort
+            if limits.has_position_limits:
+                if joint.position < limits.min_position:
+                    low = 0.0
+                elif joint.position > limits.max_position:
+                    high = 0.0
+            if joint.velocity < -limits.max_velocity:
+                low = 0.0
+            elif joint.velocity > limits.max_velocity:
+                high = 0.0
+            joint.command = clamp(joint.command, low, high)
+        elif joint.interface == POSITION:
+            if math.isnan(joint.previous_command):
+                joint.previous_command = joint.position
+            low, high = joint.lower, joint.upper
+            if limits.has_velocity_limits:
+                step = limits.max_velocity * period
+                low, high = max(joint.previous_command - step, low), min(joint.previous_command + step, high)
+            joint.command = clamp(joint.command, low, high)
+            joint.previous_command = joint.command
+        else:
+            low, high = -limits.max_velocity, limits.max_velocity
+            if limits.has_acceleration_limits:
+                step = limits.max_acceleration * period
+                low = max(joint.previous_velocity_command - step, low)
+                high = min(joint.previous_velocity_command + step, high)
+            joint.command = clamp(joint.command, low, high)
+            joint.previous_velocity_command = joint.command
+
+    def _drive(self, joint: SimJoint, period: float):
+        e_stop = self.e_stop_active
+        if joint.pid is not None:
+            if joint.interface == POSITION:
+                if joint.joint_type == "revolute":
+                    error = shortest_angular_distance_with_limits(joint.position, joint.command, joint.lower,
+                                                                  joint.upper)
+                elif joint.joint_type == "continuous":
+                    error = shortest_angular_distance(joint.position, joint.command)
+                else:
+                    error = joint.command - joint.position
+            else:
+                error = -joint.velocity if e_stop else joint.command - joint.velocity
+            limit = joint.effort_limit
+            self._send(joint, "effort", clamp(joint.pid.compute(error, period), -limit, limit))
+        elif joint.interface == EFFORT:
+            self._send(joint, "effort", 0.0 if e_stop else joint.command)
+        elif joint.interface == POSITION:
+            self._send(joint, "position", joint.command)
+        else:
+            self._send(joint, "velocity", 0.0 if e_stop else joint.command)
+
+    def _send(self, joint: SimJoint, mode: str, value: float):
+        # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is not
+        # sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's SetForce).
+        if mode != "effort" and joint.sent == (mode, value):
+            return
+        joint.sent = (mode, value)
+        limit = joint.effort_limit if math.isfinite(joint.effort_limit) else UNBOUNDED_EFFORT
+        if mode == "effort":
+            self.robot.set_joint_effort(joint.name, value)
+        elif mode == "position":
+            # Gazebo teleports the joint (SetPosition) regardless of load; Bullet's position servo with an
+            # unbounded force is the stable equivalent that still lets contacts act.
+            self.robot.set_joint_position(joint.name, value, UNBOUNDED_EFFORT)
+        else:
+            self.robot.set_joint_velocity(joint.name, value, limit)
+
+    def forget_motors(self):
+        """After a reset the engine's motors may have changed; send every setting again."""
+        for joint in self.joints.values():
+            joint.sent = None
+
+
+# <robotSimType> -> class; a robot's own hardware simulation is a class with the same interface and a line here.
+ROBOT_HW_SIMS = {"gazebo_ros_control/DefaultRobotHWSim": DefaultRobotHWSim}
