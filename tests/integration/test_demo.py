@@ -13,12 +13,21 @@ MARKER_PIXELS = 25
 SUMMARY = ("distance driven:", "tour:", "scans received:", "final odometry:", "picture:")
 
 
+def evenly_along(path, count):
+    """``count`` points spaced evenly by distance along ``path`` (by index they bunch where the robot stood)."""
+    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+    stations = np.linspace(0.0, travelled[-1], count)
+    return np.column_stack([np.interp(stations, travelled, path[:, axis]) for axis in (0, 1)])
+
+
 def test_demo_tours_the_play_ground_and_draws_its_odometry(ros_env, tmp_path):
     picture = tmp_path / "demo.png"
     result = run(["rosrun", "mbot_gazebo", "mbot_demo", "--out", str(picture)], ros_env, timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
     for line in SUMMARY:
         assert line in result.stdout, result.stdout
+    chatter = [line for line in (result.stdout + result.stderr).splitlines() if line.startswith(("[DEBUG]", "[INFO]"))]
+    assert not chatter, f"plugin logs belong in the log folder, not on the console: {chatter[:3]}"
     distance = float(result.stdout.split("distance driven:")[1].split()[0])
     assert distance > 5.0, "the tour is about 8 m"
 
@@ -29,7 +38,7 @@ def test_demo_tours_the_play_ground_and_draws_its_odometry(ros_env, tmp_path):
         pixels = np.asarray(image.convert("RGB")).astype(int)
     assert pixels.shape[:2] == (frame.height, frame.width)
     colour = np.array([int(PATH_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
-    points = frame.to_pixels(path[:: max(1, len(path) // 200)])
+    points = frame.to_pixels(evenly_along(path, 200))
     ends = frame.to_pixels(path[[0, -1]])
     # The start and end markers (and the final heading arrow) are drawn over the path around its two ends.
     visible = [point for point in points if np.min(np.hypot(*(ends - point).T)) > MARKER_PIXELS]

@@ -6,6 +6,8 @@ the same at any speed), records /odom and /scan (through TF into odom), and writ
 picture of the world, as the course's kinect sees it from the final pose, beside the top view.
 """
 import argparse
+import contextlib
+import logging
 import math
 import os
 import subprocess
@@ -18,6 +20,7 @@ import rospkg
 import rospy
 import tf2_ros
 from geometry_msgs.msg import Twist
+from mbot_sim_bridge.core.log import get_logger
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_gazebo.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
@@ -181,14 +184,37 @@ def main(argv=None):
         try:
             print(f"mbot demo: {args.world} world, lidar mbot, as fast as the machine goes (log: "
                   f"{os.path.relpath(log_dir)})", file=sys.stderr, flush=True)
-            return tour_and_draw(args, world_path, started)
+            return tour_and_draw(args, world_path, started, log_dir)
         finally:
             stop_process_group(simulation)
 
 
-def camera_frame(world_path: str, x: float, y: float, yaw: float):
+@contextlib.contextmanager
+def core_logs_to(path: str):
+    """The simulation core's log records and PyBullet's own stdout go to ``path`` only: the course's xacro sets
+    rosDebugLevel Debug, which would otherwise print every tag read on the console after the summary."""
+    logger = logging.getLogger(get_logger("mbot_sim_bridge").name)
+    handler = logging.FileHandler(path)
+    handler.setFormatter(logging.Formatter("[%(levelname)s] %(name)s: %(message)s"))
+    propagate, level = logger.propagate, logger.level
+    logger.addHandler(handler)
+    logger.propagate = False
+    sys.stdout.flush()
+    console = os.dup(1)
+    os.dup2(handler.stream.fileno(), 1)  # PyBullet prints from C, past sys.stdout
+    try:
+        yield
+    finally:
+        os.dup2(console, 1)
+        os.close(console)
+        logger.removeHandler(handler)
+        handler.close()
+        logger.propagate, logger.level = propagate, level
+
+
+def camera_frame(world_path: str, x: float, y: float, yaw: float, log_path: str):
     """What the course's kinect would see from the robot's final pose: one frame of the same camera code the
-    simulator runs (core/camera.py), rendered in a world of its own, without ROS."""
+    simulator runs (core/camera.py), rendered in a world of its own, without ROS; its logs go to ``log_path``."""
     import xacro
     from mbot_sim_bridge.core.camera import DepthCamera
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
@@ -198,17 +224,18 @@ def camera_frame(world_path: str, x: float, y: float, yaw: float):
 
     urdf = xacro.process_file(os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
                                            "mbot_with_kinect_gazebo.xacro")).toxml()
-    simulation = Simulation(parse_world(world_path), CORE_PLUGINS)
-    try:
-        spawned = simulation.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot",
-                                         pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, yaw)))
-        kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
-        return kinect.capture(simulation.sim_time).rgb
-    finally:
-        simulation.close()
+    with core_logs_to(log_path):
+        simulation = Simulation(parse_world(world_path), CORE_PLUGINS)
+        try:
+            spawned = simulation.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot",
+                                             pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, yaw)))
+            kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
+            return kinect.capture(simulation.sim_time).rgb
+        finally:
+            simulation.close()
 
 
-def tour_and_draw(args, world_path, started):
+def tour_and_draw(args, world_path, started, log_dir):
     rospy.init_node("mbot_demo", disable_signals=True)
     recorder = Recorder()
     deadline = time.monotonic() + 120
@@ -235,7 +262,7 @@ def tour_and_draw(args, world_path, started):
                f"scans received: {scans} ({len(points)} points)",
                f"final odometry: x {x:.3f} m, y {y:.3f} m, yaw {math.degrees(yaw):.1f} deg"]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    camera = camera_frame(world_path, x, y, yaw)
+    camera = camera_frame(world_path, x, y, yaw, os.path.join(log_dir, "kinect_frame.log"))
     frame = draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
                       title=f"mbot demo: {args.world}", summary_lines=summary, headings=numpy.array(headings),
                       camera_image=camera, camera_caption="the course's kinect at the end pose (640x480)")
