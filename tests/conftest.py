@@ -2,7 +2,7 @@
 import subprocess
 
 import pytest
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 
 # rostest nodes: run by the .test files, not collected by pytest.
 collect_ignore = ["nodes"]

@@ -2,7 +2,7 @@
 spawn_model waits for the simulator (or gives up after -timeout with one line)."""
 import subprocess
 
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 from ros_processes import run, wait_until
 
 

@@ -5,7 +5,7 @@ import subprocess
 import sys
 
 import pytest
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, run, wait_until
 

@@ -10,7 +10,7 @@ import os
 import pickle
 import struct
 
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 from ros_processes import TESTS, run
 
 SCRIPT = os.path.join(TESTS, "nodes", "lockstep_script.py")

@@ -3,7 +3,7 @@ import os
 import signal
 import subprocess
 
-from mbot_gazebo.processes import free_port, stop_process_group
+from mbot_sim_bridge.processes import free_port, stop_process_group
 
 from ros_processes import TESTS, run, wait_until
 

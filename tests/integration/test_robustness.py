@@ -13,7 +13,7 @@ from xml.etree import ElementTree
 import pytest
 import yaml
 
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from ros_processes import run, wait_until
 
 pytestmark = pytest.mark.long

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import rosgraph
 import yaml
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
 from xvfb import Xvfb

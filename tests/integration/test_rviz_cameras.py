@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import rosgraph
 import yaml
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
 from test_rviz import base_link_colour, colour_count, node_registered, parse_colour, published, view_3d, watch

@@ -9,7 +9,7 @@ import sys
 import textwrap
 
 import pytest
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS
 

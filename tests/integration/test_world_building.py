@@ -6,7 +6,7 @@ import os
 import xml.etree.ElementTree as ET
 
 import pytest
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 from mbot_sim_bridge.core.sdf_world import parse_world
 
 from ros_processes import TESTS, run, wait_until

@@ -14,7 +14,7 @@ from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
-from mbot_gazebo.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group
 from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
 
 CONTROLLER = "quad_velocity_controller"

@@ -16,7 +16,7 @@ import sys
 import time
 
 import rospy
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 

@@ -13,7 +13,7 @@ import time
 
 import rospy
 from geometry_msgs.msg import Twist
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 

@@ -15,7 +15,7 @@ import tempfile
 import time
 
 import rospy
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from rosgraph_msgs.msg import Clock
 
 HERE = os.path.dirname(os.path.abspath(__file__))

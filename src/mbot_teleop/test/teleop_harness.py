@@ -2,12 +2,13 @@
 
 import os
 import select
-import signal
 import subprocess
 import sys
 import termios
 import threading
 import time
+
+from mbot_sim_bridge.processes import stop_process_group
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TELEOP_SCRIPT = os.path.join(PACKAGE_DIR, 'scripts', 'mbot_teleop.py')
@@ -21,17 +22,6 @@ def wait_until(condition, timeout, interval=0.02):
         if value or time.monotonic() > deadline:
             return value or None
         time.sleep(interval)
-
-
-def stop(proc):
-    """End a process started in a session of its own: TERM, then KILL for its whole group."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait(timeout=10)
 
 
 def teleop_command(*ros_args):
@@ -105,7 +95,7 @@ class PtyProcess:
 
     def close(self):
         """Stop the process if it still runs and release the pty."""
-        stop(self.proc)
+        stop_process_group(self.proc)
         self._closing.set()
         self._reader.join(timeout=5)
         os.close(self._master)
@@ -147,6 +137,6 @@ class TwistRecorder:
             return len(self.messages)
 
     def close(self):
-        stop(self._echo)
+        stop_process_group(self._echo)
         self._reader.join(timeout=5)
         self._echo.stdout.close()

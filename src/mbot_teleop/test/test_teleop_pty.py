@@ -9,7 +9,6 @@ stays out of the ROS graph: `rostopic echo` children record the Twists.
 import itertools
 import os
 import signal
-import socket
 import subprocess
 import sys
 import termios
@@ -19,8 +18,8 @@ from xmlrpc.client import ServerProxy
 import pytest
 import rosgraph
 
-from teleop_harness import (
-    PACKAGE_DIR, PtyProcess, TwistRecorder, source_env, stop, teleop_command, wait_until)
+from mbot_sim_bridge.processes import PrivateMaster
+from teleop_harness import PACKAGE_DIR, PtyProcess, TwistRecorder, source_env, teleop_command, wait_until
 
 pytestmark = pytest.mark.long
 
@@ -37,20 +36,6 @@ STOP = (0.0, 0.0)
 _ids = itertools.count(1)
 
 
-def _free_port():
-    with socket.socket() as sock:
-        sock.bind(('127.0.0.1', 0))
-        return sock.getsockname()[1]
-
-
-def _master_answers(uri):
-    try:
-        rosgraph.Master('/teleop_pty_test', master_uri=uri).getPid()
-    except OSError:
-        return False
-    return True
-
-
 def _alive(pid):
     try:
         os.kill(pid, 0)
@@ -62,18 +47,9 @@ def _alive(pid):
 @pytest.fixture(scope='module')
 def ros_env(tmp_path_factory):
     """Start a private master; yield the environment for the processes that use it."""
-    port = _free_port()
-    env = source_env()
-    env.update(ROS_MASTER_URI=f'http://localhost:{port}/', ROS_HOSTNAME='localhost',
-               ROS_HOME=str(tmp_path_factory.mktemp('ros_home')))
-    master = subprocess.Popen(['rosmaster', '--core', '-p', str(port)], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              start_new_session=True)
-    try:
-        assert wait_until(lambda: _master_answers(env['ROS_MASTER_URI']), START_TIMEOUT)
-        yield env
-    finally:
-        stop(master)
+    with PrivateMaster(timeout=START_TIMEOUT) as master:
+        yield dict(source_env(master.environment), ROS_HOSTNAME='localhost',
+                   ROS_HOME=str(tmp_path_factory.mktemp('ros_home')))
 
 
 @pytest.fixture

@@ -20,7 +20,7 @@ import yaml
 from controller_manager_msgs.srv import LoadController, SwitchController, SwitchControllerRequest, UnloadController
 from std_msgs.msg import Bool
 
-from .stop_signal import stop_on_signals
+from mbot_sim_bridge.processes import stop_on_signals
 
 _POLL_SECONDS = 0.5
 

@@ -4,7 +4,7 @@ import sys
 import rospy
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
 
-from .stop_signal import stop_on_signals
+from mbot_sim_bridge.processes import stop_on_signals
 
 HELP = """./unspawner name1 name2 name3
 

@@ -22,7 +22,7 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.log import get_logger
 from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_gazebo.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 

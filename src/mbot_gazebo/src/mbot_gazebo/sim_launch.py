@@ -5,7 +5,6 @@ That is gazebo_ros's ``server_required:=true`` for the workspace's own launch fi
 a bad world or robot stops the whole launch with the simulator's one-line error and a non-zero status,
 instead of leaving robot_state_publisher and the spawner running on.
 """
-import signal
 import sys
 import threading
 import time
@@ -14,6 +13,7 @@ import roslaunch
 import roslaunch.parent
 import roslaunch.pmon
 import roslaunch.rlutil
+from mbot_sim_bridge.processes import stop_on_signals
 
 SERVER_NODE = "gazebo"
 
@@ -48,9 +48,7 @@ def main(argv=None):
     watch = ServerWatch()
     parent = roslaunch.parent.ROSLaunchParent(run_id, [(path, launch_args)], process_listeners=[watch])
     # Ctrl-C and kill end the launch as they end roslaunch.
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
+    stop = stop_on_signals()
     try:
         parent.start()
         # A simulator that died before the listener was registered is already in the dead list.

@@ -40,7 +40,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState, LaserScan
 from tf2_msgs.msg import TFMessage
 
-from .processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 
 ROBOT = "mbot"
 MEMORY_GROWTH_LIMIT = 0.05

@@ -6,7 +6,6 @@ use rospy.Rate or rospy.sleep, because under use_sim_time those wait for the /cl
 """
 import os
 import queue
-import signal
 import sys
 import threading
 import time
@@ -27,6 +26,7 @@ from .core.xml_values import parse_bool
 from .plugins import loop_publisher, ros_time
 from .publisher_check import check_joint_state_publishers
 from .package_uris import resolve_package_uris
+from .processes import stop_on_signals
 from .plugins.registry import REGISTRY
 from .ros_parameters import RosParameters
 from .services import GazeboRosApi
@@ -188,9 +188,7 @@ def main():
     # rospy's own SIGINT handler shuts the node down inside the signal, in whatever the main thread was doing;
     # when that is a publish or a call to the master, it waits on a lock the main thread holds, for ever.
     # Here a signal only asks the loop to stop, and the shutdown runs after it, outside any lock.
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
+    stop = stop_on_signals()
     # Running flat out, the loop thread holds the GIL between steps; every hand-off to a ROS thread (a subscriber
     # connecting, a service call, cmd_vel) then waits out the switch interval, and a connection takes dozens of
     # them: at the default 5 ms a new subscriber at real_time_factor 0 waited up to half a second (bench).

@@ -1,9 +1,11 @@
-"""ROS command lines run from Python (the demo, the benchmarks, the tests): a private master on a free port,
-and a clean stop of a launched process group."""
+"""Processes, for every package of the workspace: a private master on a free port and a clean stop of a launched
+process group (the demo, the benchmarks, the tests), and a process's own stop request on SIGINT/SIGTERM (the
+simulator node, ``./mbot sim``, the spawner and the unspawner)."""
 import os
 import signal
 import socket
 import subprocess
+import threading
 import time
 
 import rosgraph
@@ -55,3 +57,20 @@ class PrivateMaster:
 
     def __exit__(self, *exc_info):
         stop_process_group(self._process)
+
+
+def stop_on_signals() -> threading.Event:
+    """An Event that SIGINT and SIGTERM set, for a main thread that stops itself cleanly, outside any lock.
+
+    Python runs a signal handler in the main thread, and it may run while that thread is inside the same Event's
+    ``wait`` holding the Event's lock: ``Event.set`` there waits for that lock for ever (an unspawner hung so in
+    the suite). The handler therefore leaves the ``set`` to a short-lived thread of its own.
+    """
+    stop = threading.Event()
+
+    def request_stop(*_):
+        threading.Thread(target=stop.set, name="stop request", daemon=True).start()
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, request_stop)
+    return stop

@@ -1,4 +1,4 @@
-"""SIGINT sets the spawner's stop Event even when it arrives while the main thread holds that Event's lock
+"""SIGINT sets a stop Event even when it arrives while the main thread holds that Event's lock
 (inside its own ``wait``), where setting the Event in the handler itself hangs for ever."""
 import subprocess
 import sys
@@ -6,7 +6,7 @@ import sys
 # The signal is raised while the main thread holds the Event's condition lock, as it does for a moment in wait().
 CHILD = """
 import os, signal
-from controller_manager.stop_signal import stop_on_signals
+from mbot_sim_bridge.processes import stop_on_signals
 stop = stop_on_signals()
 with stop._cond:
     os.kill(os.getpid(), signal.SIGINT)
