@@ -38,8 +38,8 @@ def overlay(tmp_path_factory):
 
 def test_package_export_is_on_the_model_path(overlay):
     environment, src = overlay
-    result = run(["python3", "-c", "from mbot_sim_bridge.core.model_path import default_model_path, "
-                  "default_resource_path; print(default_model_path()); print(default_resource_path())"], environment)
+    result = run(["python3", "-c", "from mbot_sim_bridge.gazebo_paths import model_path, "
+                  "resource_path; print(model_path()); print(resource_path())"], environment)
     assert result.returncode == 0, result.stderr
     model_path, resource_path = (ast.literal_eval(line) for line in result.stdout.splitlines()[-2:])
     assert os.path.join(src, "minibot_gazebo", "models") in model_path

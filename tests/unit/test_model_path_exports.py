@@ -5,8 +5,10 @@ import os
 import textwrap
 
 import pytest
-from mbot_sim_bridge.core.model_path import (default_model_path, default_resource_path, find_model_directory,
-                                             find_world_file, package_exports)
+from mbot_sim_bridge.core.model_path import find_model_directory, find_world_file
+from mbot_sim_bridge.gazebo_paths import model_path as default_model_path
+from mbot_sim_bridge.gazebo_paths import package_exports
+from mbot_sim_bridge.gazebo_paths import resource_path as default_resource_path
 from mbot_sim_bridge.gzserver import CommandLineError, bridge_arguments
 
 from ros_processes import TESTS

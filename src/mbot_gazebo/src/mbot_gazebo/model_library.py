@@ -8,7 +8,8 @@ import os
 import xml.etree.ElementTree as ET
 from typing import List, NamedTuple, Optional, Sequence
 
-from mbot_sim_bridge.core.model_path import MODEL_MANIFESTS, default_model_path
+from mbot_sim_bridge.core.model_path import MODEL_MANIFESTS
+from mbot_sim_bridge.gazebo_paths import model_path as exported_model_path
 
 # Gazebo ships these and so does the bridge (core.sdf_world.BUILTIN_MODEL_NAMES, checked by a test; not imported
 # because it brings in PyBullet, which prints its build time); a model of the same name on the path wins.
@@ -30,7 +31,7 @@ class UnknownModel(LookupError):
 def list_models(model_path: Optional[Sequence[str]] = None) -> List[LibraryModel]:
     """Every model on ``model_path`` (default: the bridge's), sorted by name; the first of a name wins."""
     found = {}
-    for directory in default_model_path() if model_path is None else model_path:
+    for directory in exported_model_path() if model_path is None else model_path:
         if not os.path.isdir(directory):
             continue
         for name in sorted(os.listdir(directory)):

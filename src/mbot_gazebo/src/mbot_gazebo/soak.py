@@ -31,7 +31,7 @@ from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.gazebo_paths import model_path
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
@@ -128,7 +128,7 @@ class OverlapProbe:
     """A PyBullet copy of the world in which the robot is placed where the simulator has it."""
 
     def __init__(self, world_path: str, robot_xml: str):
-        world = parse_world(world_path, default_model_path())
+        world = parse_world(world_path, model_path())
         self.engine = Engine(world.physics)
         loaded = load_world(self.engine.client, world)
         self.engine.add_world(loaded)

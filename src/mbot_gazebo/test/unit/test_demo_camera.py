@@ -13,9 +13,10 @@ REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..",
 PLAYGROUND = os.path.join(REPO, "worlds", "playground.world")
 
 
-def test_the_kinect_frame_sees_the_barrier_ahead():
+def test_the_kinect_frame_sees_the_barrier_ahead(tmp_path):
     # From the origin facing +x the jersey barrier (near face at x = 5) fills the middle of the picture.
-    image = camera_frame(PLAYGROUND, 0.0, 0.0, 0.0)
+    image = camera_frame(PLAYGROUND, 0.0, 0.0, 0.0, str(tmp_path / "kinect.log"))
+    assert "[DEBUG]" in (tmp_path / "kinect.log").read_text(), "the plugins' logs (rosDebugLevel Debug) go there"
     assert image.shape == (480, 640, 3) and image.dtype == np.uint8
     sky = np.all(image == (178, 178, 178), axis=2)
     colours = len(np.unique(image.reshape(-1, 3), axis=0))

@@ -17,7 +17,8 @@ import sys
 import rospkg
 import rospy
 
-from .core.model_path import default_resource_path, find_world_file
+from .core.model_path import find_world_file
+from .gazebo_paths import resource_path
 
 # gazebo_ros's system plugins: the bridge is both of them.
 BUILT_IN_SYSTEM_PLUGINS = ("libgazebo_ros_paths_plugin.so", "libgazebo_ros_api_plugin.so")
@@ -81,7 +82,7 @@ def bridge_arguments(prog: str, argv, gui: bool = None):
     # relative one needs the resource path (a rospack run, which can take a while when its cache is cold).
     world = options.world
     if not os.path.isabs(world):
-        search_path = default_resource_path()
+        search_path = resource_path()
         world = find_world_file(options.world, search_path)
         if world is None:
             raise CommandLineError(f"world file {options.world} not found here nor on the resource "

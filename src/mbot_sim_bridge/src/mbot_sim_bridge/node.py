@@ -19,7 +19,7 @@ from rosgraph_msgs.msg import Clock
 
 from .core.clock import UpdateTimer
 from .core.errors import BridgeError, WorldError
-from .core.model_path import default_model_path
+from .gazebo_paths import model_path
 from .core.sdf_world import parse_world
 from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
 from .core.xml_values import parse_bool
@@ -62,7 +62,7 @@ class SimBridgeNode:
         joint_state_rate = float(rospy.get_param("~joint_state_rate", 100.0))
         seed = int(rospy.get_param("~seed", 0))
 
-        world = parse_world(self.world_path, default_model_path())
+        world = parse_world(self.world_path, model_path())
         gui = requested_gui and not headless and bool(os.environ.get("DISPLAY"))
         if requested_gui and not gui:
             why = "headless:=true" if headless else "no DISPLAY is set"

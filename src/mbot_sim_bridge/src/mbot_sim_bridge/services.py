@@ -21,7 +21,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from .core.engine import check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
-from .core.model_path import default_model_path
+from .gazebo_paths import model_path
 from .core.robot_model import parse_robot
 from .core.sdf_spawn import spawn_world_xml
 from .core.sdf_world import parse_world
@@ -127,7 +127,7 @@ class GazeboRosApi:
             with tempfile.NamedTemporaryFile("w", prefix="mbot_spawn_", suffix=".world") as world_file:
                 world_file.write(world_xml)
                 world_file.flush()
-                description = parse_world(world_file.name, default_model_path())
+                description = parse_world(world_file.name, model_path())
             if name not in self.sim.add_world(description):
                 raise ModelError(f"model '{name}' has no collision geometry; nothing to simulate")
             rospy.loginfo(f"spawned SDF model '{name}' at {tuple(round(v, 3) for v in pose.position)}")

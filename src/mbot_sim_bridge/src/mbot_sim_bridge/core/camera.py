@@ -34,6 +34,7 @@ from typing import Dict, NamedTuple, Optional, Tuple
 import numpy as np
 import pybullet
 
+from . import names
 from .clock import UpdateTimer
 from .errors import BridgeError, ConfigError
 from .geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
@@ -505,6 +506,7 @@ class Throttle:
 
 class Camera(Plugin):
     """Core of libgazebo_ros_camera.so: a camera sensor rendered on demand from its link."""
+    NAMESPACE_RULE = names.SENSOR
 
     GAZEBO_CLASS = "GazeboRosCamera"
     PARAMS = CAMERA_PARAMS

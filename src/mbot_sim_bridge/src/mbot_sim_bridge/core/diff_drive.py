@@ -10,6 +10,7 @@ import threading
 from dataclasses import dataclass
 from typing import Tuple
 
+from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
 from .geometry import Pose, yaw
@@ -138,6 +139,7 @@ _LOG_LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WAR
 
 class DiffDrive(Plugin):
     """The plugin's physics: wheel motors from the last command, every ``updateRate``; odometry on demand."""
+    NAMESPACE_RULE = names.MODEL
 
     GAZEBO_CLASS = "GazeboRosDiffDrive"
     PARAMS = DIFF_DRIVE_PARAMS
@@ -147,8 +149,7 @@ class DiffDrive(Plugin):
         super().__init__(context, element, sensor)
         robot = context.robot
         self.params = params = self.read_params()
-        # The namespace falls back to the model name, as in gazebo_ros (spawn_model always sets it).
-        self.namespace = params["robotNamespace"] or context.model.name
+        self.namespace = self.robot_namespace()
         for tag in ("leftJoint", "rightJoint"):
             if params[tag] not in robot.joint_index:
                 movable = ", ".join(robot.movable_joints) or "none"

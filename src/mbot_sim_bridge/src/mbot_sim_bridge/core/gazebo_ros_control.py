@@ -12,6 +12,7 @@ clock; their control runs in ``on_step``.
 """
 from typing import List
 
+from . import names
 from .log import get_logger, warn_once
 from .parameters import absolute_name
 from .params import Param
@@ -64,6 +65,7 @@ class _PublishSchedule:
 
 
 class GazeboRosControlPlugin(Plugin):
+    NAMESPACE_RULE = names.MODEL
     GAZEBO_CLASS = "GazeboRosControlPlugin"
     PARAMS = GAZEBO_ROS_CONTROL_PARAMS
     needs_every_step = True
@@ -76,7 +78,7 @@ class GazeboRosControlPlugin(Plugin):
         self.params = params
         # Absent or empty: the model name, as gazebo_ros_control (spawn_model always sets it).
         # A relative one is relative to the simulator's node, which lives at the root.
-        self.namespace = "/" + (params["robotNamespace"] or context.model.name).lstrip("/")
+        self.namespace = "/" + self.robot_namespace().lstrip("/")
         step = context.simulation.step_size
         self.control_period = params["controlPeriod"] if self.element.find("controlPeriod") is not None else step
         if self.control_period < step - _EPSILON:

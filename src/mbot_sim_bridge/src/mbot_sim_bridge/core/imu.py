@@ -32,6 +32,7 @@ from typing import NamedTuple, Optional, Tuple
 
 import numpy as np
 
+from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
 from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
@@ -99,6 +100,7 @@ class _VelocityDifference:
 
 class ImuModelPlugin(Plugin):
     """Core of libgazebo_ros_imu.so (GazeboRosIMU)."""
+    NAMESPACE_RULE = names.ROOT
 
     GAZEBO_CLASS = "GazeboRosIMU"
     PARAMS = (
@@ -209,6 +211,7 @@ def read_imu_noise(sensor: ET.Element, quantity: str, rng: np.random.Generator, 
 
 class ImuSensor(Plugin):
     """Core of libgazebo_ros_imu_sensor.so (GazeboRosImuSensor) over Gazebo's ImuSensor."""
+    NAMESPACE_RULE = names.IMU_SENSOR
 
     GAZEBO_CLASS = "GazeboRosImuSensor"
     PARAMS = (

@@ -4,6 +4,7 @@ The bridge also adds one to every robot for the movable joints no other plugin p
 them to joint_state_publisher, which can only publish zeros (the course's caster, and the wheels fighting
 the diff drive), so robot_state_publisher would not see the simulated joints.
 """
+from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
 from .params import Param
@@ -17,13 +18,14 @@ JOINT_STATE_PARAMS = (
 
 
 class JointStatePublisher(Plugin):
+    NAMESPACE_RULE = names.MODEL
     GAZEBO_CLASS = "GazeboRosJointStatePublisher"
     PARAMS = JOINT_STATE_PARAMS
 
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         params = self.read_params()
-        self.namespace = params["robotNamespace"] or context.model.name
+        self.namespace = self.robot_namespace()
         self.joint_names = [name.strip() for name in params["jointName"].split(",") if name.strip()]
         unknown = [name for name in self.joint_names if name not in context.robot.joint_index]
         if unknown:

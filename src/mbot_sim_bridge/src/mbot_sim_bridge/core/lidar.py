@@ -30,6 +30,7 @@ from typing import NamedTuple, Optional
 import numpy as np
 import pybullet
 
+from . import names
 from .clock import UpdateTimer
 from .errors import BridgeError, ConfigError
 from .geometry import IDENTITY, Pose, compose, rotation_matrix
@@ -201,6 +202,7 @@ def _check_consistency(config: RaySensorConfig, where: str) -> None:
 
 class RaySensor(Plugin):
     """Core of libgazebo_ros_laser.so: the sensor's rays, cast from its link, never hitting its own robot."""
+    NAMESPACE_RULE = names.SENSOR
 
     GAZEBO_CLASS = "GazeboRosLaser"
     PARAMS = LASER_PARAMS

@@ -7,67 +7,34 @@ deprecated ``manifest.xml``). Resources (world files, ``file://`` URIs): GAZEBO_
 exported ``gazebo_media_path``, then the workspace folder that holds ``worlds/empty.world`` (as Gazebo's own
 share folder does, so gazebo_ros's default ``worlds/empty.world`` resolves).
 
-The exports are collected with ``rospack plugins``, the command gazebo_ros's paths plugin runs through
-librospack: it reads package.xml files on ROS_PACKAGE_PATH, needs no ROS master, and lists only packages that
-depend on gazebo_ros directly, with ``${prefix}`` replaced by the package's folder.
+The exports come from the caller (``gazebo_paths.py`` in the ROS layer asks rospack for them), so the core
+runs no ROS tool.
 """
 import os
-import subprocess
 from pathlib import Path
 from typing import List, Optional, Sequence
 
-from .log import get_logger, warn_once
-
 MODEL_MANIFESTS = ("model.config", "manifest.xml")
-# rospack answers from its cache in milliseconds; a first crawl of a large ROS_PACKAGE_PATH takes longer.
-_ROSPACK_TIMEOUT_SECONDS = 60.0
-
-_log = get_logger(__name__)
 
 
-def default_model_path() -> List[str]:
+def default_model_path(exported: Sequence[str] = ()) -> List[str]:
     """Directories searched for ``model://NAME``: GAZEBO_MODEL_PATH, the packages' gazebo_model_path
-    exports, then this workspace's worlds/models."""
-    directories = _environment_path("GAZEBO_MODEL_PATH") + package_exports("gazebo_model_path")
+    exports (``exported``), then this workspace's worlds/models."""
+    directories = _environment_path("GAZEBO_MODEL_PATH") + list(exported)
     workspace_models = _workspace_models()
     if workspace_models:
         directories.append(workspace_models)
     return _unique(directories)
 
 
-def default_resource_path() -> List[str]:
+def default_resource_path(exported: Sequence[str] = ()) -> List[str]:
     """Directories world files and ``file://`` URIs are relative to: GAZEBO_RESOURCE_PATH, the packages'
-    gazebo_media_path exports, then the workspace folder holding worlds/."""
-    directories = _environment_path("GAZEBO_RESOURCE_PATH") + package_exports("gazebo_media_path")
+    gazebo_media_path exports (``exported``), then the workspace folder holding worlds/."""
+    directories = _environment_path("GAZEBO_RESOURCE_PATH") + list(exported)
     workspace_models = _workspace_models()
     if workspace_models:
         directories.append(os.path.dirname(os.path.dirname(workspace_models)))
     return _unique(directories)
-
-
-def package_exports(attribute: str) -> List[str]:
-    """The folders packages export to gazebo_ros under ``attribute`` (gazebo_model_path, gazebo_media_path,
-    plugin_path), in rospack's order; each value may hold several folders separated by ':'."""
-    command = ["rospack", "plugins", "--attrib=" + attribute, "gazebo_ros"]
-    try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=_ROSPACK_TIMEOUT_SECONDS)
-    except FileNotFoundError:
-        warn_once(_log, f"rospack is not installed (Debian package rospack-tools): the {attribute} that packages "
-                        "export in package.xml are not searched")
-        return []
-    except subprocess.TimeoutExpired:
-        warn_once(_log, f"'{' '.join(command)}' took more than {_ROSPACK_TIMEOUT_SECONDS:.0f} s: the {attribute} "
-                        "exports are not searched")
-        return []
-    if result.returncode != 0:
-        # No gazebo_ros on ROS_PACKAGE_PATH (a plain pytest run, an unsourced shell): nothing can export to it.
-        _log.debug(f"{' '.join(command)}: {result.stderr.strip()}")
-        return []
-    directories = []
-    for line in result.stdout.splitlines():
-        _package, _, value = line.strip().partition(" ")
-        directories += [entry for entry in value.split(":") if entry.strip()]
-    return directories
 
 
 def find_world_file(name: str, resource_path: Sequence[str]) -> Optional[str]:

@@ -17,6 +17,7 @@ from typing import NamedTuple, Optional, Tuple
 
 import numpy as np
 
+from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
 from .geometry import Pose, compose, inverse, pose_from_xyz_rpy
@@ -37,6 +38,7 @@ class GroundTruth(NamedTuple):
 
 class P3D(Plugin):
     """Core of libgazebo_ros_p3d.so (GazeboRosP3D)."""
+    NAMESPACE_RULE = names.ROOT
 
     GAZEBO_CLASS = "GazeboRosP3D"
     PARAMS = (

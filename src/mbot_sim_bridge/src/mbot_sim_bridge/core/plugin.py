@@ -12,6 +12,7 @@ from xml.etree import ElementTree
 import numpy as np
 
 from .clock import UpdateTimer
+from .names import plugin_namespace
 from .params import Param, PluginParams
 
 if TYPE_CHECKING:  # imported for the annotations only: the Simulation imports this module
@@ -57,6 +58,8 @@ class Plugin:
 
     timer: UpdateTimer  # set by every subclass
     needs_every_step = False
+    # How an absent or empty <robotNamespace> resolves (core/names.py): MODEL, SENSOR, ROOT or IMU_SENSOR.
+    NAMESPACE_RULE: Optional[str] = None
     driven_joints: Tuple[str, ...] = ()
     joint_states_published: Tuple[str, ...] = ()
 
@@ -86,6 +89,10 @@ class Plugin:
     def namespace_tag(self) -> Optional[str]:
         element = self.element.find("robotNamespace")
         return None if element is None else (element.text or "").strip()
+
+    def robot_namespace(self) -> str:
+        """The plugin's namespace, by its class's ``NAMESPACE_RULE``."""
+        return plugin_namespace(self.NAMESPACE_RULE, self.namespace_tag(), self.context.model.name)
 
     def read_params(self, params: Sequence[Param] = None, element: ElementTree.Element = None,
                     check_unknown: bool = True) -> Dict[str, Any]:

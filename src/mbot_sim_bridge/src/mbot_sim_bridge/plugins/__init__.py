@@ -32,27 +32,3 @@ def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
     if name.startswith("/"):
         return name
     return rospy.names.ns_join(namespace or "/", name)
-
-
-def tf_prefix(plugin, namespace: Optional[str]) -> str:
-    """tf::getPrefixParam as a plugin's NodeHandle in ``namespace`` does it: the nearest ``tf_prefix`` parameter
-    searched upwards from the namespace (how multi-robot launch files keep robots' frames apart), or ""."""
-    parameters = plugin.context.simulation.parameters
-    name = parameters.search(namespace or "/", "tf_prefix")
-    return str(parameters.get(name)) if name else ""
-
-
-def resolve_frame(frame: str, prefix: str = "") -> str:
-    """tf::resolve: an absolute frame loses its '/' and keeps no prefix; a relative one gets "prefix/"."""
-    if frame.startswith("/"):
-        return frame.lstrip("/")
-    prefix = prefix.strip("/")
-    return f"{prefix}/{frame}" if prefix else frame
-
-
-def sensor_namespace(plugin) -> str:
-    """A sensor plugin's namespace: absent means the simulator's own ("/"), empty means the model name."""
-    namespace = plugin.namespace_tag()
-    if namespace is None:
-        return "/"
-    return namespace or plugin.context.model.name

@@ -4,12 +4,13 @@ import rospy
 from sensor_msgs.msg import CameraInfo, Image
 
 from ..core.camera import Camera, Intrinsics
-from . import loop_publisher, resolve_frame, ros_time, sensor_namespace
+from ..core.names import resolve_frame
+from . import loop_publisher, ros_time
 
 
 def camera_namespace(plugin) -> str:
     """robotNamespace + "/" + cameraName, as GazeboRosCameraUtils builds its NodeHandle."""
-    return rospy.names.ns_join(sensor_namespace(plugin), plugin.params["cameraName"].strip("/"))
+    return rospy.names.ns_join(plugin.robot_namespace(), plugin.params["cameraName"].strip("/"))
 
 
 def camera_info_message(intrinsics: Intrinsics, frame_id: str) -> CameraInfo:

@@ -7,14 +7,15 @@ from tf2_msgs.msg import TFMessage
 
 from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
 from ..subscriptions import TrackedSubscriber
-from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time, tf_prefix
+from ..core.names import resolve_frame, tf_prefix
+from . import loop_publisher, resolve_in_namespace, ros_time
 
 
 class GazeboRosDiffDrive(DiffDrive):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         params = self.params
-        prefix = tf_prefix(self, self.namespace)
+        prefix = tf_prefix(self.context.simulation.parameters, self.namespace)
         self.odom_frame = resolve_frame(params["odometryFrame"], prefix)
         self.base_frame = resolve_frame(params["robotBaseFrame"], prefix)
         self.publish_odom_tf = params["publishTf"] and params["publishOdomTF"]

@@ -24,8 +24,7 @@ def imu_message(reading: ImuReading, frame_id: str) -> Imu:
 class GazeboRosImu(ImuModelPlugin):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
-        # Gazebo's NodeHandle: robotNamespace + "/" when the tag is there, else the root (not the model name).
-        namespace = self.params["robotNamespace"] or "/"
+        namespace = self.robot_namespace()
         self.publisher = self.service = None
         if self.params["topicName"]:
             self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)

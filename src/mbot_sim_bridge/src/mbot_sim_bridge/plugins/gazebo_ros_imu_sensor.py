@@ -10,9 +10,7 @@ from .gazebo_ros_imu import imu_message
 class GazeboRosImuSensor(ImuSensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
-        # Absent robotNamespace: "/MODEL/" (this plugin's own rule, unlike the other sensor plugins).
-        namespace = self.params["robotNamespace"]
-        namespace = "/" + context.model.name if namespace is None else (namespace or "/")
+        namespace = self.robot_namespace()
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
         rate = "every physics step" if self.timer.period == 0 else f"{1.0 / self.timer.period:g} Hz"
         rospy.loginfo(f"{self.label}: sensor '{sensor.get('name')}' on link '{self.link}' -> "

@@ -3,17 +3,19 @@ import rospy
 from sensor_msgs.msg import LaserScan
 
 from ..core.lidar import RaySensor
-from . import loop_publisher, resolve_frame, resolve_in_namespace, ros_time, sensor_namespace, tf_prefix
+from ..core.names import resolve_frame, tf_prefix
+from . import loop_publisher, resolve_in_namespace, ros_time
 
 
 class GazeboRosLaser(RaySensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         config = self.config
-        namespace = sensor_namespace(self)
+        namespace = self.robot_namespace()
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), LaserScan)
         self.message = LaserScan()
-        self.message.header.frame_id = resolve_frame(self.params["frameName"], tf_prefix(self, namespace))
+        prefix = tf_prefix(context.simulation.parameters, namespace)
+        self.message.header.frame_id = resolve_frame(self.params["frameName"], prefix)
         self.message.angle_min, self.message.angle_max = config.min_angle, config.max_angle
         self.message.angle_increment = config.angle_increment
         self.message.range_min, self.message.range_max = config.range_min, config.range_max

@@ -5,7 +5,8 @@ import rospy
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
 from ..core.camera import POINT_FIELDS, POINT_STEP, DepthCamera, PlainDepthCamera
-from . import loop_publisher, resolve_frame, ros_time
+from ..core.names import resolve_frame
+from . import loop_publisher, ros_time
 from .gazebo_ros_camera import camera_info_message, camera_namespace, image_message
 
 

@@ -9,7 +9,7 @@ from . import loop_publisher, resolve_in_namespace, ros_time
 class GazeboRosP3D(P3D):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
-        namespace = self.params["robotNamespace"] or "/"
+        namespace = self.robot_namespace()
         self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Odometry)
         rate = f"at {self.params['updateRate']:g} Hz" if self.params["updateRate"] else "at every physics step"
         rospy.loginfo(f"{self.label}: link '{self.body}' -> {self.publisher.resolved_name} in frame "

@@ -18,7 +18,8 @@ from ..core.ros_control.diff_drive_controller import DiffDriveController
 from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.log import get_logger, warn_once
 from ..subscriptions import TrackedSubscriber
-from . import loop_publisher, resolve_frame, resolve_in_namespace
+from ..core.names import resolve_frame
+from . import loop_publisher, resolve_in_namespace
 
 _logger = get_logger(__name__)
 

@@ -1,0 +1,53 @@
+"""The model and resource paths as gazebo_ros's paths plugin builds them: the core's order (GAZEBO_* variables,
+the exports, the workspace) with the folders that packages export to gazebo_ros in their package.xml
+(``<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>``).
+
+The exports are collected with ``rospack plugins``, the command the paths plugin runs through librospack: it
+reads package.xml files on ROS_PACKAGE_PATH, needs no ROS master, and lists only packages that depend on
+gazebo_ros directly, with ``${prefix}`` replaced by the package's folder.
+"""
+import subprocess
+from typing import List
+
+from .core.log import get_logger, warn_once
+from .core.model_path import default_model_path, default_resource_path
+
+# rospack answers from its cache in milliseconds; a first crawl of a large ROS_PACKAGE_PATH takes longer.
+_ROSPACK_TIMEOUT_SECONDS = 60.0
+
+_log = get_logger(__name__)
+
+
+def model_path() -> List[str]:
+    """Where ``model://NAME`` is looked up."""
+    return default_model_path(package_exports("gazebo_model_path"))
+
+
+def resource_path() -> List[str]:
+    """Where world files and ``file://`` URIs are looked up."""
+    return default_resource_path(package_exports("gazebo_media_path"))
+
+
+def package_exports(attribute: str) -> List[str]:
+    """The folders packages export to gazebo_ros under ``attribute`` (gazebo_model_path, gazebo_media_path,
+    plugin_path), in rospack's order; each value may hold several folders separated by ':'."""
+    command = ["rospack", "plugins", "--attrib=" + attribute, "gazebo_ros"]
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=_ROSPACK_TIMEOUT_SECONDS)
+    except FileNotFoundError:
+        warn_once(_log, f"rospack is not installed (Debian package rospack-tools): the {attribute} that packages "
+                        "export in package.xml are not searched")
+        return []
+    except subprocess.TimeoutExpired:
+        warn_once(_log, f"'{' '.join(command)}' took more than {_ROSPACK_TIMEOUT_SECONDS:.0f} s: the {attribute} "
+                        "exports are not searched")
+        return []
+    if result.returncode != 0:
+        # No gazebo_ros on ROS_PACKAGE_PATH (a plain pytest run, an unsourced shell): nothing can export to it.
+        _log.debug(f"{' '.join(command)}: {result.stderr.strip()}")
+        return []
+    directories = []
+    for line in result.stdout.splitlines():
+        _package, _, value = line.strip().partition(" ")
+        directories += [entry for entry in value.split(":") if entry.strip()]
+    return directories
