@@ -11,6 +11,7 @@ import unittest
 import numpy
 import rospy
 import rostest
+from mbot_gazebo.footprints import footprint
 from mbot_sim_bridge.core.sdf_world import parse_world
 from sensor_msgs.msg import LaserScan
 
@@ -50,7 +51,7 @@ class RoomScan(unittest.TestCase):
         rospy.init_node("room_scan_test")
         Simulator()
         world = parse_world(rospy.get_param("~world"))
-        polygons = [list(shape.outline()) for shape in world.shapes if shape.kind != "plane"
+        polygons = [list(footprint(shape)) for shape in world.shapes if shape.kind != "plane"
                     and shape.bounds()[0][2] <= LASER_POSITION[2] <= shape.bounds()[1][2]]
         scans = []
         subscriber = rospy.Subscriber("/scan", LaserScan, scans.append)

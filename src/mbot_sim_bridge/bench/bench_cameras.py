@@ -26,10 +26,11 @@ sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
 
 from sensor_msgs.msg import Image, Imu  # noqa: E402 (after the path set-up)
 
-from mbot_sim_bridge.core.camera import RENDERER_ENV, Camera, DepthCamera  # noqa: E402
+from mbot_sim_bridge.core.camera import Camera, DepthCamera  # noqa: E402
 from mbot_sim_bridge.core.diff_drive import DiffDrive  # noqa: E402
 from mbot_sim_bridge.core.imu import ImuModelPlugin  # noqa: E402
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS  # noqa: E402
+from mbot_sim_bridge.core.render_scene import RENDERER_ENV  # noqa: E402
 from mbot_sim_bridge.core.robot_model import parse_robot  # noqa: E402
 from mbot_sim_bridge.core.sdf_world import parse_world  # noqa: E402
 from mbot_sim_bridge.core.simulation import Simulation  # noqa: E402

@@ -21,6 +21,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
 
+from .footprints import footprint
+
 IMAGE_SIZE = (1000, 750)  # PNG width, height in pixels
 GROUND_COLOUR = "#eef1e6"
 OBSTACLE_COLOUR = "#7d8590"
@@ -89,7 +91,7 @@ def draw_demo(world, path_xy, scan_points_xy, out_path: str, title: str = "", su
     """
     path = _finite_points(path_xy)
     scan = _finite_points(scan_points_xy)
-    obstacles = [np.asarray(shape.outline()) for shape in world.shapes if shape.kind != "plane"]
+    obstacles = [np.asarray(footprint(shape)) for shape in world.shapes if shape.kind != "plane"]
     obstacles = [outline for outline in obstacles if len(outline) >= 3]
 
     figure = Figure(figsize=(IMAGE_SIZE[0] / _DPI, IMAGE_SIZE[1] / _DPI), dpi=_DPI)

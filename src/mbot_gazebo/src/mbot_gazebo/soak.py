@@ -42,6 +42,8 @@ from tf2_msgs.msg import TFMessage
 
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 
+from .footprints import footprint
+
 ROBOT = "mbot"
 MEMORY_GROWTH_LIMIT = 0.05
 # Deeper than this, the robot is inside an obstacle or the floor (contact penetration stays at a few mm).
@@ -137,7 +139,7 @@ class OverlapProbe:
         self.movable = [model.name for model in world.models if not model.static and model.name in loaded.bodies]
         # A static mesh is a hollow triangle surface to Bullet: a robot wholly inside one touches no triangle.
         # Its top-view outline and height catch that case.
-        self.mesh_footprints = [(model.name, numpy.asarray(shape.outline()), shape.bounds()[0][2],
+        self.mesh_footprints = [(model.name, numpy.asarray(footprint(shape)), shape.bounds()[0][2],
                                  shape.bounds()[1][2])
                                 for model in world.models if model.static for shape in model.shapes
                                 if shape.kind == "mesh"]

@@ -6,6 +6,7 @@ import pytest
 from matplotlib.colors import to_rgb
 from PIL import Image
 
+from mbot_gazebo.footprints import footprint
 from mbot_gazebo.demo_plot import IMAGE_SIZE, OBSTACLE_COLOUR, PATH_COLOUR, SCAN_COLOUR, PlotFrame, draw_demo
 from mbot_sim_bridge.core.sdf_world import parse_world
 
@@ -35,7 +36,7 @@ def scan_points(world, run):
     end = run[0][-1]
     points = []
     for shape in world.shapes:
-        outline = np.asarray(shape.outline())
+        outline = np.asarray(footprint(shape))
         for start, stop in zip(outline, np.roll(outline, -1, axis=0)):
             steps = max(2, int(np.linalg.norm(stop - start) / 0.05))
             points.extend(start + (stop - start) * t for t in np.linspace(0.0, 1.0, steps, endpoint=False))
@@ -95,7 +96,7 @@ def test_scan_points_are_drawn_where_they_are(drawing, scan_points):
 def test_obstacle_is_filled_at_its_centre(drawing, world):
     _, frame, image = drawing
     barrier = next(shape for shape in world.shapes if shape.model == "jersey_barrier")
-    centre = np.mean(np.asarray(barrier.outline()), axis=0)
+    centre = np.mean(np.asarray(footprint(barrier)), axis=0)
     assert matches(pixels_at(image, frame, [centre]), OBSTACLE_COLOUR).all()
 
 

@@ -11,7 +11,7 @@ import rospy
 from mbot_sim_msgs.srv import SaveWorldResponse
 
 from .core.errors import BridgeError, WorldError
-from .core.sdf_world import WorldDescription
+from .core.world_description import WorldDescription
 from .core.world_writer import WorldSnapshot, take_snapshot, world_sdf, write_world_file
 
 PLUGINS_AS_TAGS = ("robots are written as inline SDF models; their plugins are kept as <plugin> tags, which "

@@ -7,9 +7,9 @@ import numpy as np
 import pybullet
 import pytest
 
-from mbot_sim_bridge.core.camera import (
-    Camera, CameraConfig, DepthCamera, Intrinsics, camera_intrinsics, convert_image, depth_16uc1,
-    depth_in_range, image_encoding, linear_depth, point_cloud)
+from mbot_sim_bridge.core.camera import Camera, CameraConfig, DepthCamera, Intrinsics, camera_intrinsics
+from mbot_sim_bridge.core.image_formats import (convert_image, depth_16uc1, depth_in_range, image_encoding,
+                                                linear_depth, point_cloud)
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.robot_model import parse_robot
@@ -185,7 +185,7 @@ def test_frames_follow_the_sensor_rate_and_the_depth_plugin_renders_once_per_fra
 def test_tinyrenderer_is_the_default_and_egl_is_measured_against_it(tmp_path, monkeypatch):
     """TinyRenderer is kept because the EGL renderer does not put things where CameraInfo says; the figures
     show by how much (a box at a known place, 640x480)."""
-    from mbot_sim_bridge.core.camera import CameraRenderer
+    from mbot_sim_bridge.core.render_scene import CameraRenderer
     config = CameraConfig("c", "l", 640, 480, math.radians(60), near=0.05, far=8.0)
     k = camera_intrinsics(config, {})
     centre = (2.0, 0.6, 0.9)  # seen from (0, 0, 0.5) looking along +x

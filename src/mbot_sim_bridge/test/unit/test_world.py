@@ -12,7 +12,8 @@ import pytest
 from mbot_sim_bridge.core.errors import WorldError
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.mesh import load_mesh
-from mbot_sim_bridge.core.sdf_world import PhysicsConfig, parse_world
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.world_description import PhysicsConfig
 from mbot_sim_bridge.core.world_bodies import load_world, world_lateral_friction
 from mbot_sim_bridge.core.model_path import default_model_path
 
@@ -123,14 +124,14 @@ def playground(client, no_gazebo_model_path):
     return description, build(client, description)
 
 
-def _distance_to_polygon(polygon):
-    """Distance from the origin to a polygon that does not contain it."""
-    points = np.array(polygon + polygon[:1])
-    distances = []
-    for a, b in zip(points[:-1], points[1:]):
-        t = np.clip(-a @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
-        distances.append(np.linalg.norm(a + t * (b - a)))
-    return min(distances)
+def _distance_from_origin(shape):
+    """Top-view distance from the origin to a convex shape that does not cover it: the nearest of the segments
+    between any two of its points (its outline's edges among them; the others run inside it, farther away)."""
+    points = shape.world_points()[:, :2]
+    a, b = (array.reshape(-1, 2) for array in np.broadcast_arrays(points[:, None], points[None, :]))
+    along = b - a
+    t = np.clip(-np.einsum("ij,ij->i", a, along) / np.maximum(np.einsum("ij,ij->i", along, along), 1e-12), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(a + t[:, None] * along, axis=1)))
 
 
 def test_playground_keeps_the_demo_rectangle_free(playground):
@@ -147,7 +148,7 @@ def test_playground_obstacles_lie_1_5_to_6_m_from_the_start(playground):
     obstacles = [model for model in description.models if model.name != "ground_plane"]
     assert len(obstacles) >= 8
     for model in obstacles:
-        nearest = min(_distance_to_polygon(list(shape.outline())) for shape in model.shapes)
+        nearest = min(_distance_from_origin(shape) for shape in model.shapes)
         assert 1.5 <= nearest <= 6.0, model.name
 
 
@@ -395,16 +396,6 @@ def test_binary_stl_reads_like_ascii_stl(tmp_path):
     binary_mesh = load_mesh(str(path))
     assert np.array_equal(binary_mesh.vertices, ascii_mesh.vertices)
     assert np.array_equal(binary_mesh.triangles, ascii_mesh.triangles)
-
-
-def test_outline_is_the_top_view_footprint():
-    description = read_test_world("nested_poses.world")
-    ball = shape_named(description, "ball")
-    radii = [math.hypot(x + 1.0, y - 0.5) for x, y in ball.outline()]
-    assert len(radii) == 32 and radii == pytest.approx([0.1] * 32, abs=1e-6)
-    tip = shape_named(description, "tip")  # 0.2 x 0.4 box turned 180 degrees at the origin
-    assert sorted(tip.outline()) == pytest.approx([(-0.1, -0.2), (-0.1, 0.2), (0.1, -0.2), (0.1, 0.2)], abs=1e-6)
-    assert read_test_world("include.world").shapes[0].outline() == ()  # the infinite ground plane
 
 
 # --- Bad input ---------------------------------------------------------------------------------------------------

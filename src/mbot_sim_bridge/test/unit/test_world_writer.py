@@ -12,7 +12,8 @@ from mbot_sim_bridge.core.geometry import Pose, compose, inverse, pose_from_xyz_
 from mbot_sim_bridge.core.model_path import default_model_path
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import PhysicsConfig, parse_world
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.world_description import PhysicsConfig
 from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.core.world_writer import pose_text, take_snapshot, world_sdf, write_world_file
 

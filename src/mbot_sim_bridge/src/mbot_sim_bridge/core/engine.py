@@ -18,7 +18,7 @@ from .errors import ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
 from .log import get_logger, warn_once
 from .robot_model import RobotModel
-from .sdf_world import PhysicsConfig
+from .world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
 from .xml_values import check_range, parse_float
 

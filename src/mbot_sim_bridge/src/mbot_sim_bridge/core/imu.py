@@ -39,7 +39,8 @@ from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
 from .log import get_logger, warn_once
 from .params import Param, PluginParams, non_negative
 from .plugin import Plugin
-from .xml_values import parse_floats, read_pose
+from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
+from .xml_values import parse_floats
 
 _log = get_logger(__name__)
 
@@ -196,11 +197,7 @@ def read_imu_noise(sensor: ET.Element, quantity: str, rng: np.random.Generator, 
         for tag in _UNSUPPORTED_NOISE_TAGS:
             if element.find(tag) is not None:
                 warn_once(_log, f"{where}: {label}: <{quantity}><{name}><noise><{tag}> is not simulated")
-        if values["type"] == "none":
-            continue
-        if values["type"] != "gaussian":
-            warn_once(_log, f"{where}: {label}: noise type '{values['type']}' is not supported (only gaussian); "
-                            f"<{quantity}><{name}> is noise-free")
+        if not gaussian_noise(element, values["type"], f"{where}: {label}", f"<{quantity}><{name}>"):
             continue
         mean[axis], stddev[axis] = values["mean"], values["stddev"]
         if values["bias_mean"] or values["bias_stddev"]:
@@ -236,14 +233,13 @@ class ImuSensor(Plugin):
         self.params = self.read_params()
         robot = context.robot
         where = context.where(element)
-        name = sensor.get("name") or "imu"
-        label = f"imu '{name}' on link '{context.link}'"
-        sensor_rate = PluginParams(sensor, label, where=context.where(sensor), check_unknown=False).read(
+        name, sensor_where, label = sensor_label(sensor, "imu", context.link, robot.model.document)
+        sensor_rate = PluginParams(sensor, label, where=sensor_where, check_unknown=False).read(
             self.SENSOR_PARAMS)["update_rate"]
         if self.params["initialOrientationAsReference"]:
             warn_once(_log, f"{self.label}: <initialOrientationAsReference> true is deprecated (REP 145) and not "
                             f"emulated; the world is the orientation reference")
-        self.sensor_pose = read_pose(sensor.find("pose"), robot.model.document)
+        self.sensor_pose = sensor_pose(sensor, robot.model.document, sensor_where, label)
         self.link = context.link
         rpy = read_vector_param(element, "rpyOffset", self.label, where) or (0.0, 0.0, 0.0)
         read_vector_param(element, "xyzOffset", self.label, where)

@@ -32,12 +32,13 @@ import pybullet
 
 from . import names
 from .clock import UpdateTimer
-from .errors import BridgeError, ConfigError
+from .errors import ConfigError
 from .geometry import IDENTITY, Pose, compose, rotation_matrix
-from .log import get_logger, info_once, warn_once
+from .log import get_logger, info_once
 from .params import Param, PluginParams, non_negative, positive
 from .plugin import Plugin
-from .xml_values import XmlDocument, read_pose
+from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
+from .xml_values import XmlDocument
 
 _log = get_logger(__name__)
 
@@ -130,20 +131,14 @@ def parse_ray_sensor(sensor_element: ET.Element, link_name: str, document: XmlDo
     Bad values raise ``ConfigError`` naming where, the sensor, the tag, the value and the valid range;
     unsupported noise types are logged once and ignored.
     """
-    name = sensor_element.get("name")
-    where = document.where(sensor_element)
-    if not name:
-        raise ConfigError(f"{where}: a <sensor> on link '{link_name}' has no name")
-    label = f"lidar '{name}' on link '{link_name}'"
+    name, where, label = sensor_label(sensor_element, "lidar", link_name, document)
     if sensor_element.get("type") not in ("ray", "gpu_ray"):
         raise ConfigError(f"{where}: {label}: type '{sensor_element.get('type')}' is not a ray sensor "
                           f"(expected 'ray' or 'gpu_ray')")
     values = PluginParams(sensor_element, label, where=where, check_unknown=False).read(RAY_SENSOR_PARAMS)
-    try:
-        pose = read_pose(sensor_element.find("pose"), document)
-    except BridgeError as error:
-        raise ConfigError(f"{where}: {label}: {str(error).split(': ', 1)[1]}") from None
-    noise_mean, noise_stddev = _noise(sensor_element, values, f"{where}: {label}")
+    pose = sensor_pose(sensor_element, document, where, label)
+    noisy = gaussian_noise(sensor_element.find("ray/noise"), values["ray/noise/type"], f"{where}: {label}", "the scan")
+    noise_mean, noise_stddev = (values["ray/noise/mean"], values["ray/noise/stddev"]) if noisy else (None, None)
     config = RaySensorConfig(
         sensor_name=name,
         link=link_name,
@@ -164,17 +159,6 @@ def parse_ray_sensor(sensor_element: ET.Element, link_name: str, document: XmlDo
     )
     _check_consistency(config, f"{where}: {label}")
     return config
-
-
-def _noise(sensor: ET.Element, values: dict, where: str):
-    """(mean, stddev) of the gaussian ray noise, or (None, None) when there is none to simulate."""
-    if sensor.find("ray/noise") is None or values["ray/noise/type"] == "none":
-        return None, None
-    if values["ray/noise/type"] != "gaussian":
-        warn_once(_log, f"{where}: <noise><type> '{values['ray/noise/type']}' is not supported (only gaussian "
-                        f"is); the scan is noise-free")
-        return None, None
-    return values["ray/noise/mean"], values["ray/noise/stddev"]
 
 
 def _check_consistency(config: RaySensorConfig, where: str) -> None:

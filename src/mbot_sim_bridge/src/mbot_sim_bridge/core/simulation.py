@@ -22,8 +22,9 @@ from .log import get_logger, warn_once
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext
 from .plugin_table import filename_of
+from .render_scene import RenderScene
 from .robot_model import RobotModel
-from .sdf_world import ModelDescription, WorldDescription
+from .world_description import ModelDescription, WorldDescription
 from .viewer import Viewer
 from .world_bodies import load_world
 
@@ -74,6 +75,7 @@ class Simulation:
         self._build_order: List[object] = []
         self._plugins: List[Plugin] = []
         self._every_step: List[Plugin] = []
+        self._render_scene: Optional[RenderScene] = None
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -84,6 +86,13 @@ class Simulation:
     @property
     def step_size(self) -> float:
         return self.engine.physics.max_step_size
+
+    @property
+    def render_scene(self) -> RenderScene:
+        """What the cameras see, made when the first one asks (a world without cameras pays nothing)."""
+        if self._render_scene is None:
+            self._render_scene = RenderScene(self)
+        return self._render_scene
 
     def model_names(self) -> List[str]:
         return self.engine.model_names()

@@ -8,17 +8,13 @@ from dataclasses import dataclass
 from typing import Dict, Optional, Tuple
 
 import numpy as np
-import pybullet
 
 from .geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
 from .log import get_logger, warn_once
-from .sdf_world import ModelDescription, PhysicsConfig, Shape, WorldDescription
+from .pybullet_shapes import collision_shape, welded_body
+from .world_description import ModelDescription, PhysicsConfig, Shape, WorldDescription
 
 _log = get_logger(__name__)
-
-# PyBullet's createCollisionShape limits for mesh data passed as arrays.
-_BULLET_MAX_MESH_VERTICES = 131072
-_BULLET_MAX_MESH_INDICES = 524288
 
 
 @dataclass(frozen=True)
@@ -58,7 +54,7 @@ def load_world(client, description: WorldDescription) -> LoadedWorld:
         # Its collision sits at its pose in the model frame, so the body's frame stays the model's.
         single = model.static and len(model.shapes) == 1
         frame = compose(inverse(model.pose), model.shapes[0].pose) if single else None
-        collision_shapes = [(shape, _collision_shape(client, shape, model.static, frame)) for shape in model.shapes]
+        collision_shapes = [(shape, collision_shape(client, shape, model.static, frame)) for shape in model.shapes]
         collision_shapes = [(shape, index) for shape, index in collision_shapes if index is not None]
         if not collision_shapes:
             _log.debug(f"model '{model.name}' has no collision shape; no body created")
@@ -80,49 +76,13 @@ def load_world(client, description: WorldDescription) -> LoadedWorld:
     return LoadedWorld(description.physics, bodies, tuple(shapes), inertial_frames)
 
 
-def _collision_shape(client, shape: Shape, concave: bool, frame: Optional[Pose] = None) -> Optional[int]:
-    """The PyBullet shape of ``shape``, placed at ``frame`` in its body's frame (None: at the origin)."""
-    placed = {} if frame is None else dict(collisionFramePosition=frame.position,
-                                           collisionFrameOrientation=frame.orientation)
-    if shape.kind == "box":
-        return client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[s / 2.0 for s in shape.size], **placed)
-    if shape.kind == "cylinder":
-        return client.createCollisionShape(pybullet.GEOM_CYLINDER, radius=shape.radius, height=shape.length,
-                                           **placed)
-    if shape.kind == "sphere":
-        return client.createCollisionShape(pybullet.GEOM_SPHERE, radius=shape.radius, **placed)
-    if shape.kind == "plane":
-        return client.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=shape.normal, **placed)
-    vertices, triangles = shape.mesh.vertices, shape.mesh.triangles
-    if len(vertices) > _BULLET_MAX_MESH_VERTICES or (concave and triangles.size > _BULLET_MAX_MESH_INDICES):
-        warn_once(_log, f"{shape.mesh_path}: {len(vertices)} vertices and {len(triangles)} triangles exceed "
-                        f"PyBullet's mesh limits ({_BULLET_MAX_MESH_VERTICES}, {_BULLET_MAX_MESH_INDICES // 3}); "
-                        f"collision '{shape.name}' of model '{shape.model}' skipped")
-        return None
-    if concave:  # a triangle mesh, as ODE collides it, works in Bullet only for bodies that never move
-        return client.createCollisionShape(pybullet.GEOM_MESH, vertices=vertices.tolist(),
-                                           indices=triangles.ravel().tolist(), **placed)
-    return client.createCollisionShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), **placed)  # convex hull
-
-
 def _create_body(client, model: ModelDescription, collision_shapes) -> Tuple[int, Pose]:
     world_to_model = inverse(model.pose)
-    child_frames = [compose(world_to_model, shape.pose) for shape, _ in collision_shapes]
     mass, inertial_frame, moments = (0.0, IDENTITY, None) if model.static else _mass_properties(model)
     if not model.static and mass == 0.0:
         warn_once(_log, f"model '{model.name}' is not static but has no mass; PyBullet keeps it fixed")
-    count = len(collision_shapes)
-    body = client.createMultiBody(
-        baseMass=mass, baseCollisionShapeIndex=-1, basePosition=model.pose.position,
-        baseOrientation=model.pose.orientation, baseInertialFramePosition=inertial_frame.position,
-        baseInertialFrameOrientation=inertial_frame.orientation,
-        linkMasses=[0.0] * count, linkCollisionShapeIndices=[index for _, index in collision_shapes],
-        linkVisualShapeIndices=[-1] * count, linkPositions=[frame.position for frame in child_frames],
-        linkOrientations=[frame.orientation for frame in child_frames],
-        linkInertialFramePositions=[IDENTITY.position] * count,
-        linkInertialFrameOrientations=[IDENTITY.orientation] * count,
-        linkParentIndices=[0] * count, linkJointTypes=[pybullet.JOINT_FIXED] * count,
-        linkJointAxis=[(0.0, 0.0, 1.0)] * count)
+    parts = [(index, compose(world_to_model, shape.pose)) for shape, index in collision_shapes]
+    body = welded_body(client, model.pose, parts, visual=False, mass=mass, inertial_frame=inertial_frame)
     if moments is not None:
         client.changeDynamics(body, -1, localInertiaDiagonal=moments)
     return body, inertial_frame

@@ -20,7 +20,7 @@ from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
 from .errors import WorldError
 from .geometry import Pose, compose, inverse, rpy
 from .robot_model import RobotModel
-from .sdf_world import ModelDescription, PhysicsConfig, WorldDescription
+from .world_description import ModelDescription, PhysicsConfig, WorldDescription
 
 SDF_VERSION = "1.6"
 # Frame semantics that came with 1.7; a copied model that uses them makes the file 1.7 (Gazebo 11 reads both).

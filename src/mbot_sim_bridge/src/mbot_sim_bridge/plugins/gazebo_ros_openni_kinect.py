@@ -4,7 +4,8 @@ something is subscribed."""
 import rospy
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
-from ..core.camera import POINT_FIELDS, POINT_STEP, DepthCamera, PlainDepthCamera
+from ..core.camera import DepthCamera, PlainDepthCamera
+from ..core.image_formats import POINT_FIELDS, POINT_STEP
 from ..core.names import resolve_frame
 from . import loop_publisher, ros_time
 from .gazebo_ros_camera import camera_info_message, camera_namespace, image_message
