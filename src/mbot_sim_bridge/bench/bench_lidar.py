@@ -7,9 +7,7 @@ LaserScanner.scan(), then the median of the bare rayTestBatch call inside it, on
     PYTHONPATH=src/mbot_sim_bridge/src .venv/bin/python src/mbot_sim_bridge/bench/bench_lidar.py
 """
 import argparse
-import contextlib
 import os
-import sys
 import time
 
 import numpy as np
@@ -18,6 +16,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from mbot_sim_bridge.core.geometry import compose, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig
+from mbot_sim_bridge.processes import stdout_redirected
 
 # The tutorial's rplidar (lidar_gazebo.xacro).
 RPLIDAR = RaySensorConfig(sensor_name="rplidar", link="laser_link", samples=360, min_angle=-3.0,
@@ -26,21 +25,6 @@ RPLIDAR = RaySensorConfig(sensor_name="rplidar", link="laser_link", samples=360,
 ROBOT_GROUP = 1 << 8
 # The mbot's laser_link sits 0.08 m ahead of and 0.072 m above base_footprint.
 LASER_IN_BASE = pose_from_xyz_rpy((0.08, 0.0, 0.072), (0.0, 0.0, 0.0))
-
-
-@contextlib.contextmanager
-def c_stdout_silenced():
-    """PyBullet's C code prints "argv[0]=" on connecting; keep stdout for the figures."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
 
 
 def add_box(client, half_extents, xyz, yaw=0.0):
@@ -82,7 +66,7 @@ def main():
     parser.add_argument("--scans", type=int, default=500, help="timed scans (default 500)")
     args = parser.parse_args()
 
-    with c_stdout_silenced():
+    with open(os.devnull, "w") as devnull, stdout_redirected(devnull):  # PyBullet prints "argv[0]="
         client = BulletClient(connection_mode=pybullet.DIRECT)
     build_world(client)
     scanner = LaserScanner(client, RPLIDAR, np.random.default_rng(0))

@@ -22,7 +22,7 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.log import get_logger
 from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stdout_redirected, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
@@ -199,14 +199,10 @@ def core_logs_to(path: str):
     propagate, level = logger.propagate, logger.level
     logger.addHandler(handler)
     logger.propagate = False
-    sys.stdout.flush()
-    console = os.dup(1)
-    os.dup2(handler.stream.fileno(), 1)  # PyBullet prints from C, past sys.stdout
     try:
-        yield
+        with stdout_redirected(handler.stream):
+            yield
     finally:
-        os.dup2(console, 1)
-        os.close(console)
         logger.removeHandler(handler)
         handler.close()
         logger.propagate, logger.level = propagate, level

@@ -1,10 +1,12 @@
 """Processes, for every package of the workspace: a private master on a free port and a clean stop of a launched
 process group (the demo, the benchmarks, the tests), and a process's own stop request on SIGINT/SIGTERM (the
-simulator node, ``./mbot sim``, the spawner and the unspawner)."""
+simulator node, ``./mbot sim``, the spawner and the unspawner); this process's C-level stdout redirected."""
+import contextlib
 import os
 import signal
 import socket
 import subprocess
+import sys
 import threading
 import time
 
@@ -74,3 +76,17 @@ def stop_on_signals() -> threading.Event:
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, request_stop)
     return stop
+
+
+@contextlib.contextmanager
+def stdout_redirected(stream):
+    """File descriptor 1 (where PyBullet's C code prints, past ``sys.stdout``) goes to ``stream``, a file open
+    for writing, meanwhile."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(stream.fileno(), 1)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)

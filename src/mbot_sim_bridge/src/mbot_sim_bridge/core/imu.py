@@ -35,7 +35,7 @@ import numpy as np
 from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
-from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
+from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, rotation_matrix
 from .log import get_logger, warn_once
 from .params import Param, PluginParams, non_negative
 from .plugin import Plugin
@@ -56,13 +56,6 @@ class ImuReading(NamedTuple):
     angular_velocity: Vector
     linear_acceleration: Vector
     covariance: float  # the value on every covariance diagonal
-
-
-def _quaternion_matrix(q) -> np.ndarray:
-    x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 def read_vector_param(element: ET.Element, tag: str, label: str, where: str) -> Optional[Vector]:
@@ -149,22 +142,24 @@ class ImuModelPlugin(Plugin):
         super().reset(now)
         self.difference.reset(self.context.robot.link_world_velocity(self.link)[0], now)
 
-    def idle(self, idle: bool):
-        """While nothing reads the IMU, look again only every IDLE_PERIOD instead of every step."""
-        self.timer.period = max(self.period, IDLE_PERIOD) if idle else self.period
+    def idle(self, now: float):
+        """While nothing reads the IMU, look again only every IDLE_PERIOD instead of every step; Gazebo keeps
+        its last time and velocity meanwhile, and the next reading differences from them."""
+        self.timer.period = max(self.period, IDLE_PERIOD)
 
     def read(self, now: float) -> ImuReading:
         robot = self.context.robot
         pose = robot.link_world_pose(self.link)
         linear, angular = robot.link_world_velocity(self.link)
         orientation = compose(self.offset, Pose((0.0, 0.0, 0.0), pose.orientation)).orientation
-        rotation = _quaternion_matrix(orientation)
+        rotation = np.asarray(rotation_matrix(orientation))
         noise = self.rng.normal(0.0, self.noise, 6) if self.noise > 0 else np.zeros(6)
         acceleration = self.difference(linear, now)
         return ImuReading(now, tuple(orientation), tuple(rotation @ (np.asarray(angular) + noise[:3])),
                           tuple(rotation @ (acceleration + noise[3:])), self.noise ** 2)
 
     def update(self, now: float):
+        self.timer.period = self.period
         self.latest = self.read(now)
 
 
@@ -269,16 +264,20 @@ class ImuSensor(Plugin):
         if self.sensor_pose == IDENTITY:
             return linear
         link_pose = robot.link_world_pose(self.link)
-        arm = _quaternion_matrix(link_pose.orientation) @ np.asarray(self.sensor_pose.position)
+        arm = np.asarray(rotation_matrix(link_pose.orientation)) @ np.asarray(self.sensor_pose.position)
         return np.asarray(linear) + np.cross(angular, arm)
 
     def reset(self, now: float):
         super().reset(now)
         self.difference.reset(self._point_velocity(), now)
 
+    def idle(self, now: float):
+        """While nothing reads the sensor, the next reading differences from the velocity now."""
+        self.difference.reset(self._point_velocity(), now)
+
     def read(self, now: float) -> ImuReading:
         pose = self._world_pose()
-        rotation = _quaternion_matrix(pose.orientation)
+        rotation = np.asarray(rotation_matrix(pose.orientation))
         _, angular = self.context.robot.link_world_velocity(self.link)
         acceleration = self.difference(self._point_velocity(), now)
         gyro = rotation.T @ np.asarray(angular)

@@ -20,8 +20,8 @@ import numpy as np
 from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
-from .geometry import Pose, compose, inverse, pose_from_xyz_rpy
-from .imu import IDLE_PERIOD, _quaternion_matrix, read_vector_param
+from .geometry import Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
+from .imu import IDLE_PERIOD, read_vector_param
 from .params import Param, non_negative
 from .plugin import Plugin
 
@@ -81,9 +81,9 @@ class P3D(Plugin):
         self.period = self.timer.period
         self.latest: Optional[GroundTruth] = None
 
-    def idle(self, idle: bool):
+    def idle(self, now: float):
         """While nothing reads the ground truth, look again only every IDLE_PERIOD instead of every step."""
-        self.timer.period = max(self.period, IDLE_PERIOD) if idle else self.period
+        self.timer.period = max(self.period, IDLE_PERIOD)
 
     def read(self, now: float) -> GroundTruth:
         robot = self.context.robot
@@ -93,7 +93,7 @@ class P3D(Plugin):
             frame = robot.link_world_pose(self.reference)
             frame_linear, frame_angular = (np.asarray(v) for v in robot.link_world_velocity(self.reference))
             pose = compose(inverse(frame), pose)
-            rotation = _quaternion_matrix(frame.orientation)
+            rotation = np.asarray(rotation_matrix(frame.orientation))
             linear, angular = rotation @ (linear - frame_linear), rotation @ (angular - frame_angular)
         orientation = compose(self.rotation_offset, Pose((0.0, 0.0, 0.0), pose.orientation)).orientation
         position = tuple(np.asarray(pose.position) + self.xyz_offset)
@@ -103,4 +103,5 @@ class P3D(Plugin):
         return GroundTruth(now, Pose(position, tuple(orientation)), tuple(linear), tuple(angular), self.noise ** 2)
 
     def update(self, now: float):
+        self.timer.period = self.period
         self.latest = self.read(now)

@@ -105,7 +105,11 @@ class Plugin:
         """After every physics step, when ``needs_every_step``."""
 
     def update(self, now: float):
-        """When ``timer`` is due, with the sim time in seconds."""
+        """When ``timer`` is due, with the sim time in seconds: compute the outputs into the plugin's state."""
+
+    def idle(self, now: float):
+        """When ``timer`` is due but nothing takes the outputs (the ROS layer calls it instead of ``update``
+        while no one subscribes, as gazebo_ros's sensors work only then): keep what the next update needs."""
 
     def reset(self, now: float):
         """World or simulation reset (Gazebo calls the plugin's Reset())."""

@@ -1,8 +1,10 @@
 """The ROS side of the emulated gazebo_ros plugins: one module and class per Gazebo ``.so``.
 
-Each class extends the plugin's core class (``core/``) with its publishers and subscribers and nothing else;
-``registry.REGISTRY`` maps the Gazebo file name to it. Updates run in the loop thread that owns the engine;
-subscriber callbacks only store values under the core's lock.
+Each class is ``RosPlugin`` mixed into the plugin's core class (``core/``): it adds the publishers and
+subscribers (owned by ``self.topics``) and nothing else, and calls only the core's hooks (``update``, ``idle``
+and the values they leave). ``registry.REGISTRY`` maps the Gazebo file name to it. Updates run in the loop
+thread that owns the engine; subscriber callbacks only store values under the core's lock. Messages are
+built in ``messages.py``.
 """
 import warnings
 from typing import Optional
@@ -32,3 +34,40 @@ def resolve_in_namespace(namespace: Optional[str], name: str) -> str:
     if name.startswith("/"):
         return name
     return rospy.names.ns_join(namespace or "/", name)
+
+
+class PluginTopics:
+    """The publishers, services and subscribers one plugin owns: made the loop's way, asked whether anyone
+    listens (the loop publishes synchronously, so a topic nobody takes is work skipped), and closed together."""
+
+    def __init__(self):
+        self._owned = []
+
+    def publisher(self, name: str, message_type) -> rospy.Publisher:
+        return self.own(loop_publisher(name, message_type))
+
+    def own(self, handle):
+        """Close ``handle`` (a rospy Service, Subscriber or TrackedSubscriber) with the others; returns it."""
+        self._owned.append(handle)
+        return handle
+
+    @staticmethod
+    def listened(*publishers: Optional[rospy.Publisher]) -> bool:
+        return any(publisher is not None and publisher.get_num_connections() > 0 for publisher in publishers)
+
+    def close(self):
+        for handle in self._owned:
+            handle.shutdown() if isinstance(handle, rospy.Service) else handle.unregister()
+        self._owned.clear()
+
+
+class RosPlugin:
+    """Mixed in before a core plugin class: ``self.topics``, closed with the plugin."""
+
+    def __init__(self, *args, **kwargs):
+        self.topics = PluginTopics()
+        super().__init__(*args, **kwargs)
+
+    def close(self):
+        self.topics.close()
+        super().close()

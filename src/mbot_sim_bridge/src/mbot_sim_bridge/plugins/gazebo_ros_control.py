@@ -17,31 +17,30 @@ from std_msgs.msg import Bool
 
 from ..core.gazebo_ros_control import GazeboRosControlPlugin
 from ..subscriptions import TrackedSubscriber
-from . import resolve_in_namespace, ros_time
+from . import RosPlugin, resolve_in_namespace, ros_time
 from .ros_controllers import ROS_CONTROLLERS
 
 _BASE_CLASS = "controller_interface::ControllerBase"
 
 
-class GazeboRosControl(GazeboRosControlPlugin):
+class GazeboRosControl(RosPlugin, GazeboRosControlPlugin):
     CONTROLLERS = ROS_CONTROLLERS
 
     def __init__(self, context, element, sensor=None):
         self._services_lock = threading.Lock()
         super().__init__(context, element, sensor)
         prefix = resolve_in_namespace(self.namespace, "controller_manager") + "/"
-        self.e_stop_subscriber = None
         if self.params["eStopTopic"]:
-            self.e_stop_subscriber = TrackedSubscriber(resolve_in_namespace(self.namespace, self.params["eStopTopic"]),
-                                                       Bool, self._on_e_stop)
+            self.topics.own(TrackedSubscriber(resolve_in_namespace(self.namespace, self.params["eStopTopic"]), Bool,
+                                              self._on_e_stop))
         handlers = (("list_controllers", ListControllers, self._list_controllers),
                     ("list_controller_types", ListControllerTypes, self._list_controller_types),
                     ("load_controller", LoadController, self._load_controller),
                     ("unload_controller", UnloadController, self._unload_controller),
                     ("switch_controller", SwitchController, self._switch_controller),
                     ("reload_controller_libraries", ReloadControllerLibraries, self._reload_libraries))
-        self.services = [rospy.Service(prefix + name, service_type, self._serialized(handler))
-                         for name, service_type, handler in handlers]
+        for name, service_type, handler in handlers:
+            self.topics.own(rospy.Service(prefix + name, service_type, self._serialized(handler)))
         joints = ", ".join(f"{name}: {joint.interface}" for name, joint in self.hw.joints.items())
         rospy.loginfo(f"{self.label}: controller manager in namespace {self.namespace}: {len(self.hw.joints)} joints "
                       f"({joints}), control period {self.control_period:.4f} s")
@@ -116,10 +115,3 @@ class GazeboRosControl(GazeboRosControlPlugin):
                     return ReloadControllerLibrariesResponse(False)
         rospy.loginfo("Controller manager: reloaded controller libraries for 'controller_interface'")
         return ReloadControllerLibrariesResponse(True)
-
-    def close(self):
-        for service in self.services:
-            service.shutdown()
-        if self.e_stop_subscriber is not None:
-            self.e_stop_subscriber.unregister()
-        super().close()

@@ -8,10 +8,11 @@ from tf2_msgs.msg import TFMessage
 from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame, tf_prefix
-from . import loop_publisher, resolve_in_namespace, ros_time
+from . import RosPlugin, resolve_in_namespace, ros_time
+from .messages import set_pose, set_quaternion, set_xyz
 
 
-class GazeboRosDiffDrive(DiffDrive):
+class GazeboRosDiffDrive(RosPlugin, DiffDrive):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         params = self.params
@@ -20,14 +21,15 @@ class GazeboRosDiffDrive(DiffDrive):
         self.base_frame = resolve_frame(params["robotBaseFrame"], prefix)
         self.publish_odom_tf = params["publishTf"] and params["publishOdomTF"]
         # publishTf=false means no odometry topic at all, not just no TF (gazebo_ros reads it that way).
-        self.odom_publisher = (loop_publisher(resolve_in_namespace(self.namespace, params["odometryTopic"]),
-                                              Odometry) if params["publishTf"] else None)
-        self.tf_publisher = loop_publisher("/tf", TFMessage) if self.publish_odom_tf else None
-        self.joint_state_publisher = (loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
-                                      if self.joint_states_published else None)
+        topics = self.topics
+        self.odom_publisher = (topics.publisher(resolve_in_namespace(self.namespace, params["odometryTopic"]),
+                                                Odometry) if params["publishTf"] else None)
+        self.tf_publisher = topics.publisher("/tf", TFMessage) if self.publish_odom_tf else None
+        self.joint_state_publisher = (topics.publisher(resolve_in_namespace(self.namespace, "joint_states"),
+                                                       JointState) if self.joint_states_published else None)
         self._make_messages()
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
-        self.subscriber = TrackedSubscriber(self.command_topic, Twist, self._on_command)
+        topics.own(TrackedSubscriber(self.command_topic, Twist, self._on_command))
         if params["publishWheelTF"]:
             rospy.loginfo(f"{self.label}: publishWheelTF: the wheel frames reach /tf through robot_state_publisher "
                           "from joint_states; they are not broadcast a second time (that duplicate is what makes "
@@ -48,15 +50,15 @@ class GazeboRosDiffDrive(DiffDrive):
     def update(self, now: float):
         # Topics nobody listens to are skipped: the loop publishes synchronously, so each costs real time.
         stamp = ros_time(now)
-        odometry_wanted = self.odom_publisher is not None and self.odom_publisher.get_num_connections()
-        tf_wanted = self.tf_publisher is not None and self.tf_publisher.get_num_connections()
+        odometry_wanted = self.topics.listened(self.odom_publisher)
+        tf_wanted = self.topics.listened(self.tf_publisher)
         if odometry_wanted or tf_wanted:
             odometry = self.odometry()
             if odometry_wanted:
                 self._publish_odometry(stamp, odometry)
             if tf_wanted:
                 self._publish_odom_tf(stamp, odometry)
-        if self.joint_state_publisher is not None and self.joint_state_publisher.get_num_connections():
+        if self.topics.listened(self.joint_state_publisher):
             self._publish_wheel_joint_states(stamp)
         super().update(now)
 
@@ -79,9 +81,8 @@ class GazeboRosDiffDrive(DiffDrive):
         (position, orientation), (vx, vy), wz = odometry_values
         odometry = self.odometry_message
         odometry.header.stamp = stamp
-        pose, twist = odometry.pose.pose, odometry.twist.twist
-        pose.position.x, pose.position.y, pose.position.z = position
-        pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = orientation
+        set_pose(odometry.pose.pose, position, orientation)
+        twist = odometry.twist.twist
         twist.linear.x, twist.linear.y, twist.angular.z = vx, vy, wz
         self.odom_publisher.publish(odometry)
 
@@ -89,18 +90,11 @@ class GazeboRosDiffDrive(DiffDrive):
         (position, orientation), _, _ = odometry_values
         transform = self.tf_message.transforms[0]
         transform.header.stamp = stamp
-        translation, rotation = transform.transform.translation, transform.transform.rotation
-        translation.x, translation.y, translation.z = position
-        rotation.x, rotation.y, rotation.z, rotation.w = orientation
+        set_xyz(transform.transform.translation, position)
+        set_quaternion(transform.transform.rotation, orientation)
         self.tf_publisher.publish(self.tf_message)
 
     def _publish_wheel_joint_states(self, stamp):
         self.wheel_states.header.stamp = stamp
         self.wheel_states.position = [state[0] for state in self.context.robot.joint_state(self.wheel_states.name)]
         self.joint_state_publisher.publish(self.wheel_states)
-
-    def close(self):
-        self.subscriber.unregister()
-        for publisher in (self.odom_publisher, self.tf_publisher, self.joint_state_publisher):
-            if publisher is not None:
-                publisher.unregister()

@@ -3,25 +3,22 @@ import rospy
 from sensor_msgs.msg import Imu
 
 from ..core.imu import ImuSensor
-from . import loop_publisher, resolve_in_namespace
-from .gazebo_ros_imu import imu_message
+from . import RosPlugin, resolve_in_namespace
+from .messages import imu_message
 
 
-class GazeboRosImuSensor(ImuSensor):
+class GazeboRosImuSensor(RosPlugin, ImuSensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         namespace = self.robot_namespace()
-        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
+        self.publisher = self.topics.publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
         rate = "every physics step" if self.timer.period == 0 else f"{1.0 / self.timer.period:g} Hz"
         rospy.loginfo(f"{self.label}: sensor '{sensor.get('name')}' on link '{self.link}' -> "
                       f"{self.publisher.resolved_name} (frame '{self.params['frameName']}') at {rate}")
 
     def update(self, now: float):
-        if self.publisher.get_num_connections() == 0:
-            self.difference.reset(self._point_velocity(), now)
+        if not self.topics.listened(self.publisher):
+            self.idle(now)
             return
         super().update(now)
         self.publisher.publish(imu_message(self.latest, self.params["frameName"]))
-
-    def close(self):
-        self.publisher.unregister()

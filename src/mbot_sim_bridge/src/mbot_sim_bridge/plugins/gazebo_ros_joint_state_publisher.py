@@ -2,17 +2,17 @@
 from sensor_msgs.msg import JointState
 
 from ..core.joint_states import JointStatePublisher
-from . import loop_publisher, resolve_in_namespace, ros_time
+from . import RosPlugin, resolve_in_namespace, ros_time
 
 
-class GazeboRosJointStatePublisher(JointStatePublisher):
+class GazeboRosJointStatePublisher(RosPlugin, JointStatePublisher):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
-        self.publisher = loop_publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
+        self.publisher = self.topics.publisher(resolve_in_namespace(self.namespace, "joint_states"), JointState)
         self.message = JointState(name=self.joint_names)  # refilled at each update
 
     def update(self, now: float):
-        if not self.publisher.get_num_connections():
+        if not self.topics.listened(self.publisher):
             return
         message = self.message
         message.header.stamp = ros_time(now)
@@ -21,6 +21,3 @@ class GazeboRosJointStatePublisher(JointStatePublisher):
         message.velocity = [state[1] for state in states]
         message.effort = [state[2] for state in states]
         self.publisher.publish(message)
-
-    def close(self):
-        self.publisher.unregister()

@@ -4,15 +4,15 @@ from sensor_msgs.msg import LaserScan
 
 from ..core.lidar import RaySensor
 from ..core.names import resolve_frame, tf_prefix
-from . import loop_publisher, resolve_in_namespace, ros_time
+from . import RosPlugin, resolve_in_namespace, ros_time
 
 
-class GazeboRosLaser(RaySensor):
+class GazeboRosLaser(RosPlugin, RaySensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         config = self.config
         namespace = self.robot_namespace()
-        self.publisher = loop_publisher(resolve_in_namespace(namespace, self.params["topicName"]), LaserScan)
+        self.publisher = self.topics.publisher(resolve_in_namespace(namespace, self.params["topicName"]), LaserScan)
         self.message = LaserScan()
         prefix = tf_prefix(context.simulation.parameters, namespace)
         self.message.header.frame_id = resolve_frame(self.params["frameName"], prefix)
@@ -26,13 +26,10 @@ class GazeboRosLaser(RaySensor):
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor works only while someone listens.
-        if self.publisher.get_num_connections() == 0:
+        if not self.topics.listened(self.publisher):
             return
         scan = self.scan()
         self.message.header.stamp = ros_time(now)
         self.message.ranges = scan.ranges.tolist()
         self.message.intensities = scan.intensities.tolist()
         self.publisher.publish(self.message)
-
-    def close(self):
-        self.publisher.unregister()

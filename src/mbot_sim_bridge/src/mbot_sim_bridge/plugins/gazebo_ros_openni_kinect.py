@@ -7,18 +7,19 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 from ..core.camera import DepthCamera, PlainDepthCamera
 from ..core.image_formats import POINT_FIELDS, POINT_STEP
 from ..core.names import resolve_frame
-from . import loop_publisher, ros_time
-from .gazebo_ros_camera import camera_info_message, camera_namespace, image_message
+from . import RosPlugin, ros_time
+from .gazebo_ros_camera import camera_namespace
+from .messages import camera_info_message, image_message
 
 
-class GazeboRosOpenniKinect(DepthCamera):
+class GazeboRosOpenniKinect(RosPlugin, DepthCamera):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         namespace = camera_namespace(self)
         params = self.params
 
         def publisher(tag, message_type):
-            return loop_publisher(rospy.names.ns_join(namespace, params[tag]), message_type)
+            return self.topics.publisher(rospy.names.ns_join(namespace, params[tag]), message_type)
 
         self.frame_id = resolve_frame(params["frameName"])
         self.image_publisher = publisher("imageTopicName", Image)
@@ -47,9 +48,8 @@ class GazeboRosOpenniKinect(DepthCamera):
                           "libgazebo_ros_depth_camera.so are not published")
 
     def update(self, now: float):
-        image_wanted = self.image_publisher.get_num_connections() > 0
-        depth_wanted = self.depth_publisher.get_num_connections() > 0
-        cloud_wanted = self.cloud_publisher.get_num_connections() > 0
+        image_wanted, depth_wanted, cloud_wanted = (self.topics.listened(publisher) for publisher in (
+            self.image_publisher, self.depth_publisher, self.cloud_publisher))
         stamp = ros_time(now)
         if image_wanted or depth_wanted or cloud_wanted:
             frame = self.capture(now)
@@ -69,16 +69,11 @@ class GazeboRosOpenniKinect(DepthCamera):
                 self.cloud_publisher.publish(self.cloud)
         # The camera_info topics follow the plugin's updateRate, each while it has subscribers.
         info_wanted = [publisher for publisher in (self.info_publisher, self.depth_info_publisher)
-                       if publisher.get_num_connections() > 0]
+                       if self.topics.listened(publisher)]
         if info_wanted and self.throttle.passes(now):
             self.info.header.stamp = stamp
             for publisher in info_wanted:
                 publisher.publish(self.info)
-
-    def close(self):
-        for publisher in (self.image_publisher, self.info_publisher, self.depth_publisher,
-                          self.depth_info_publisher, self.cloud_publisher):
-            publisher.unregister()
 
 
 class GazeboRosDepthCamera(GazeboRosOpenniKinect, PlainDepthCamera):
