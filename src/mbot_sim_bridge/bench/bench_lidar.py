@@ -16,7 +16,8 @@ from pybullet_utils.bullet_client import BulletClient
 
 from mbot_sim_bridge.core.geometry import compose, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig
-from mbot_sim_bridge.processes import stdout_redirected
+from mbot_sim_bridge.core.log import c_stdout_to
+
 
 # The tutorial's rplidar (lidar_gazebo.xacro).
 RPLIDAR = RaySensorConfig(sensor_name="rplidar", link="laser_link", samples=360, min_angle=-3.0,
@@ -66,7 +67,7 @@ def main():
     parser.add_argument("--scans", type=int, default=500, help="timed scans (default 500)")
     args = parser.parse_args()
 
-    with open(os.devnull, "w") as devnull, stdout_redirected(devnull):  # PyBullet prints "argv[0]="
+    with open(os.devnull, "w") as devnull, c_stdout_to(devnull):  # PyBullet prints "argv[0]="
         client = BulletClient(connection_mode=pybullet.DIRECT)
     build_world(client)
     scanner = LaserScanner(client, RPLIDAR, np.random.default_rng(0))

@@ -20,9 +20,9 @@ import rospkg
 import rospy
 import tf2_ros
 from geometry_msgs.msg import Twist
-from mbot_sim_bridge.core.log import get_logger
+from mbot_sim_bridge.core.log import c_stdout_to, get_logger
 from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_sim_bridge.processes import PrivateMaster, stdout_redirected, stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
@@ -200,7 +200,7 @@ def core_logs_to(path: str):
     logger.addHandler(handler)
     logger.propagate = False
     try:
-        with stdout_redirected(handler.stream):
+        with c_stdout_to(handler.stream):
             yield
     finally:
         logger.removeHandler(handler)

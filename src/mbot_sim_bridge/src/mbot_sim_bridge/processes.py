@@ -1,12 +1,10 @@
 """Processes, for every package of the workspace: a private master on a free port and a clean stop of a launched
 process group (the demo, the benchmarks, the tests), and a process's own stop request on SIGINT/SIGTERM (the
-simulator node, ``./mbot sim``, the spawner and the unspawner); this process's C-level stdout redirected."""
-import contextlib
+simulator node, ``./mbot sim``, the spawner and the unspawner)."""
 import os
 import signal
 import socket
 import subprocess
-import sys
 import threading
 import time
 
@@ -77,16 +75,3 @@ def stop_on_signals() -> threading.Event:
         signal.signal(signum, request_stop)
     return stop
 
-
-@contextlib.contextmanager
-def stdout_redirected(stream):
-    """File descriptor 1 (where PyBullet's C code prints, past ``sys.stdout``) goes to ``stream``, a file open
-    for writing, meanwhile."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    os.dup2(stream.fileno(), 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)

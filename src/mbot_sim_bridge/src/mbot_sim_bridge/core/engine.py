@@ -3,10 +3,8 @@
 Each Engine owns its own BulletClient (never PyBullet's module-global client), so tests can run several
 side by side. Sim time is kept as a whole number of physics steps, so it never drifts.
 """
-import contextlib
 import math
 import os
-import sys
 import tempfile
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
@@ -16,7 +14,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from .errors import ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
-from .log import get_logger, warn_once
+from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
 from .world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
@@ -33,20 +31,6 @@ DEFAULT_MU = 1.0
 # Collision-filter group bits handed to spawned robots, one bit each, so a robot's own sensors can skip it.
 _FIRST_ROBOT_GROUP_BIT = 4
 _LAST_ROBOT_GROUP_BIT = 30
-
-
-@contextlib.contextmanager
-def _stdout_silenced():
-    """PyBullet's URDF importer prints its link merging to the C stdout; keep that out of the node's output."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    with open(os.devnull, "w") as devnull:
-        os.dup2(devnull.fileno(), 1)
-    try:
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 @dataclass
@@ -319,7 +303,8 @@ class Engine:
                 urdf_file.write(model.pybullet_urdf)
             flags = (pybullet.URDF_MERGE_FIXED_LINKS | pybullet.URDF_USE_INERTIA_FROM_FILE
                      | pybullet.URDF_USE_IMPLICIT_CYLINDER)
-            with _stdout_silenced():
+            # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
+            with open(os.devnull, "w") as devnull, c_stdout_to(devnull):
                 body = self.client.loadURDF(path, flags=flags)
         except pybullet.error as error:
             raise ModelError(f"PyBullet could not load model '{model.name}': {error}") from None

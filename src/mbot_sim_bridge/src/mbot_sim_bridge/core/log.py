@@ -1,9 +1,12 @@
-"""Logging for the core.
+"""Logging for the core, and where PyBullet's own prints go.
 
 Core modules log to children of the stdlib logger ``rosout``: under rospy that logger reaches the console
 and /rosout, under pytest it reaches ``caplog``. ``warn_once`` keeps a bad input from flooding the log.
 """
+import contextlib
 import logging
+import os
+import sys
 import threading
 
 _warned = set()
@@ -36,3 +39,17 @@ def forget_warnings() -> None:
     """Let every warning be logged again (tests use this to check a warning appears)."""
     with _warned_lock:
         _warned.clear()
+
+
+@contextlib.contextmanager
+def c_stdout_to(stream):
+    """File descriptor 1, where PyBullet's C code prints (past ``sys.stdout``), goes to ``stream`` (a file open
+    for writing) meanwhile."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(stream.fileno(), 1)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
