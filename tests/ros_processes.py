@@ -18,3 +18,40 @@ def wait_until(condition, timeout, what):
 def run(command, environment, timeout=90, stdin=None):
     """Run a ROS command line to completion; returns the CompletedProcess (text output)."""
     return subprocess.run(command, env=environment, capture_output=True, text=True, timeout=timeout, stdin=stdin)
+
+
+def service_up(environment, service):
+    """Whether the master knows ``service`` (asked from this process, as ``rosservice list`` would)."""
+    import rosgraph
+
+    try:
+        rosgraph.Master("/test", master_uri=environment["ROS_MASTER_URI"]).lookupService(service)
+        return True
+    except (rosgraph.MasterError, OSError):
+        return False
+
+
+def call_service(environment, service, request="{}", timeout=60):
+    """What ``rosservice call SERVICE REQUEST`` prints, parsed, but called from this process: a service client
+    needs no node, and a ``rosservice`` process costs a second or more of interpreter start on a loaded machine.
+    Raises rospy.ServiceException as the command would fail."""
+    import genpy
+    import rospy
+    import rosservice
+    import yaml
+
+    # rosgraph reads the master's address from the environment at every lookup.
+    saved = os.environ.get("ROS_MASTER_URI")
+    os.environ["ROS_MASTER_URI"] = environment["ROS_MASTER_URI"]
+    try:
+        rospy.wait_for_service(service, timeout)
+        service_class = rosservice.get_service_class_by_name(service)
+        message = service_class._request_class()
+        genpy.message.fill_message_args(message, [yaml.safe_load(request)])
+        response = rospy.ServiceProxy(service, service_class)(message)
+    finally:
+        if saved is None:
+            del os.environ["ROS_MASTER_URI"]
+        else:
+            os.environ["ROS_MASTER_URI"] = saved
+    return yaml.safe_load(genpy.message.strify_message(response))

@@ -3,7 +3,7 @@ spawn_model waits for the simulator (or gives up after -timeout with one line)."
 import subprocess
 
 from mbot_sim_bridge.processes import stop_process_group
-from ros_processes import run, wait_until
+from ros_processes import call_service, run, service_up, wait_until
 
 
 def clock_message(ros_env, timeout):
@@ -16,16 +16,12 @@ def clock_message(ros_env, timeout):
     return result.stdout if result.returncode == 0 else None
 
 
-def service_up(ros_env, name):
-    return name in run(["rosservice", "list"], ros_env).stdout.split()
-
-
 def test_started_paused_no_clock_until_unpaused(ros_env, launch):
     launch("mbot_sim_bridge", "empty_world.launch", "gui:=false", "paused:=true")
     wait_until(lambda: service_up(ros_env, "/gazebo/unpause_physics"), 60, "the simulator's services")
     # A window in which a running simulator would publish hundreds of /clock messages.
     assert clock_message(ros_env, timeout=3) is None, "/clock was published while paused"
-    assert run(["rosservice", "call", "/gazebo/unpause_physics"], ros_env).returncode == 0
+    call_service(ros_env, "/gazebo/unpause_physics")
     assert clock_message(ros_env, timeout=30) is not None
 
 

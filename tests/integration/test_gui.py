@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from ros_processes import run, wait_until
+from ros_processes import call_service, service_up, wait_until
 from xvfb import Xvfb
 
 MIN_ROBOT_PIXELS = 200
@@ -18,7 +18,8 @@ def gazebo_blue_pixels(image) -> int:
 
 
 def spawned(ros_env):
-    return "mbot" in run(["rosservice", "call", "/gazebo/get_world_properties"], ros_env).stdout
+    return (service_up(ros_env, "/gazebo/get_world_properties")
+            and "mbot" in call_service(ros_env, "/gazebo/get_world_properties")["model_names"])
 
 
 def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):

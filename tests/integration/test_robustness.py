@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
-from ros_processes import run, wait_until
+from ros_processes import call_service, run, wait_until
 
 pytestmark = pytest.mark.long
 
@@ -72,10 +72,8 @@ def spawn(ros_env, tmp_path, name, xml, *arguments, kind="-urdf", timeout=REFUSA
                ros_env, timeout=timeout)
 
 
-def call(ros_env, service, request="{}", timeout=CALL_TIMEOUT):
-    result = run(["rosservice", "call", "/gazebo/" + service, request], ros_env, timeout=timeout)
-    assert result.returncode == 0, f"rosservice call {service} failed:\n{result.stdout}{result.stderr}"
-    return yaml.safe_load(result.stdout)
+def call(ros_env, service, request="{}"):
+    return call_service(ros_env, "/gazebo/" + service, request, CALL_TIMEOUT)
 
 
 def echo(ros_env, topic, timeout=CALL_TIMEOUT):
@@ -89,6 +87,10 @@ def model_pose(ros_env, name):
     assert state["success"], state
     position = state["pose"]["position"]
     return tuple(float(position[axis]) for axis in "xyz")
+
+
+def sim_time(ros_env):
+    return call(ros_env, "get_world_properties")["sim_time"]
 
 
 def model_names(ros_env):
@@ -130,18 +132,21 @@ def assert_still_serving(ros_env, bridge, drive=False):
     """The bridge runs, its clock advances, and the good mbot still publishes finite odometry (and, with
     ``drive``, still drives: a few seconds more, spent where a request could have wedged the robot)."""
     assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
-    first = echo(ros_env, "/clock")["clock"]
+    first = sim_time(ros_env)
     odometry = echo(ros_env, "/good/odom")
     position = odometry["pose"]["pose"]["position"]
     assert all(math.isfinite(float(position[axis])) for axis in "xyz"), odometry
     if drive:
         before = model_pose(ros_env, "good")
         # A reset stops the drive (as Gazebo's Reset does): command it again each time.
-        run(["rostopic", "pub", "-1", "/good/cmd_vel", "geometry_msgs/Twist",
-             "{linear: {x: 0.2}, angular: {z: 0.5}}"], ros_env)
-        wait_until(lambda: math.dist(model_pose(ros_env, "good"), before) > 1e-3, 30, "the good mbot to move")
-    later = echo(ros_env, "/clock")["clock"]
-    assert (later["secs"], later["nsecs"]) > (first["secs"], first["nsecs"])
+        command = subprocess.Popen(["rostopic", "pub", "-r", "10", "/good/cmd_vel", "geometry_msgs/Twist",
+                                    "{linear: {x: 0.2}, angular: {z: 0.5}}"], env=ros_env,
+                                   stdout=subprocess.DEVNULL, start_new_session=True)
+        try:
+            wait_until(lambda: math.dist(model_pose(ros_env, "good"), before) > 1e-3, 30, "the good mbot to move")
+        finally:
+            stop_process_group(command)
+    wait_until(lambda: sim_time(ros_env) > first, 10, "the clock to advance")
     assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
 
 

@@ -9,7 +9,7 @@ import pytest
 from mbot_sim_bridge.processes import stop_process_group
 from mbot_sim_bridge.core.sdf_world import parse_world
 
-from ros_processes import TESTS, run, wait_until
+from ros_processes import TESTS, call_service, run, service_up, wait_until
 
 pytestmark = pytest.mark.long
 
@@ -17,10 +17,6 @@ WORLDS = os.path.join(os.path.dirname(TESTS), "worlds")
 POSITION_TOLERANCE = 1e-3  # m
 ANGLE_TOLERANCE = 1e-3  # rad
 START_TIMEOUT = 90  # s: the bridge on a loaded two-core machine
-
-
-def service_up(ros_env, name):
-    return name in run(["rosservice", "list"], ros_env).stdout.split()
 
 
 def start_bridge(ros_env, launch, *arguments):
@@ -44,7 +40,7 @@ def model_poses(ros_env):
 
 
 def paused(ros_env):
-    return "pause: True" in ok(run(["rosservice", "call", "/gazebo/get_physics_properties"], ros_env))
+    return call_service(ros_env, "/gazebo/get_physics_properties")["pause"]
 
 
 def angle_between(a, b):
@@ -77,7 +73,7 @@ def test_insert_move_save_and_relaunch_finds_every_model_where_it_was(ros_env, l
     ok(mbot_world(ros_env, "delete", "coke_can"))
     ok(mbot_world(ros_env, "move", "unit_box_0", "-x", "0", "-y", "-3", "-Y", "1.0"))
     # Paused, nothing settles further between reading the poses and saving them.
-    ok(run(["rosservice", "call", "/gazebo/pause_physics"], ros_env))
+    call_service(ros_env, "/gazebo/pause_physics")
     before = model_poses(ros_env)
     assert sorted(before) == ["barrel", "cafe_table", "ground_plane", "unit_box", "unit_box_0"]
     assert math.dist(before["unit_box_0"][0][:2], (0.0, -3.0)) < POSITION_TOLERANCE
