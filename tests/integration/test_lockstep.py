@@ -9,14 +9,19 @@ own ROS time allows, which depends on when /clock reaches it."""
 import os
 import pickle
 import struct
+import threading
+import time
 
+import pytest
 from mbot_sim_bridge.processes import stop_process_group
-from ros_processes import TESTS, run
+from ros_processes import TESTS, call_service, run, service_up, wait_until
 
 SCRIPT = os.path.join(TESTS, "nodes", "lockstep_script.py")
 LAUNCH = os.path.join(TESTS, "launch", "lockstep_mbot.launch")
 # Messages that start with a std_msgs/Header: rospy writes its per-publisher counter into header.seq.
 TOPICS_WITH_HEADER = ("/odom", "/scan", "/joint_states")
+STEP = "/gazebo/step_simulation"
+STOP_SECONDS = 5.0  # roslaunch's own Ctrl-C handling included
 
 
 def recorded_run(ros_env, launch, tmp_path, name):
@@ -59,3 +64,33 @@ def test_lockstep_orders_commands_and_reruns_are_bit_identical(ros_env, launch, 
     assert bridge_only(second["after_reset"]) == bridge_only(first["after_reset"])
     identical = sum(len(messages) for messages in bridge_only(recording).values())
     print(f"figure: two launches and a reset: {identical} serialized messages of the bridge identical byte for byte")
+
+
+def test_step_simulation_answers_every_count(ros_env, launch):
+    bridge = launch(LAUNCH)
+    wait_until(lambda: service_up(ros_env, STEP), 90, "the simulator's step_simulation")
+    response = call_service(ros_env, STEP, "{steps: 0}")
+    assert response["success"] and response["sim_time"] == 0.0, response
+    largest = 2 ** 32 - 1  # uint32: a negative count or 2**63 cannot even be sent (the client refuses to encode it)
+    response = call_service(ros_env, STEP, f"{{steps: {largest}}}")
+    assert not response["success"] and "step in parts" in response["status_message"], response
+    assert "\n" not in response["status_message"]
+    with pytest.raises(Exception, match="(?i)uint32|out of range|format requires|argument out of range"):
+        call_service(ros_env, STEP, f"{{steps: {2 ** 63}}}")
+    response = call_service(ros_env, STEP, "{steps: 10}")
+    assert response["success"] and response["sim_time"] == pytest.approx(0.01), response
+    # The longest call allowed (an hour of sim time) still ends at Ctrl-C within a second or two.
+    long_call = threading.Thread(target=call_ignoring_errors, args=(ros_env, STEP, "{steps: 3600000}"), daemon=True)
+    long_call.start()
+    assert run(["rostopic", "echo", "-n", "1", "/clock"], ros_env, timeout=60).returncode == 0
+    started = time.monotonic()
+    assert stop_process_group(bridge)
+    assert time.monotonic() - started < STOP_SECONDS
+    long_call.join(timeout=30)
+
+
+def call_ignoring_errors(*arguments):
+    try:
+        call_service(*arguments)
+    except Exception:  # the simulator stops under the call: its answer never comes, which is the point
+        pass

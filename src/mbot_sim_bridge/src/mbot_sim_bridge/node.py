@@ -79,6 +79,7 @@ class SimBridgeNode:
         self.clock_timer = UpdateTimer(clock_frequency)
         self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
         self._requests: "queue.Queue[tuple]" = queue.Queue()
+        self._stop = threading.Event()  # set by run(): a stop asked for while a step request runs
         self._pace_wall_start = self._pace_sim_start = 0.0
         self._last_clock = -1.0
         # gazebo_ros sets /use_sim_time only when nobody has.
@@ -115,12 +116,14 @@ class SimBridgeNode:
     def step(self, count: int):
         """Exactly ``count`` physics steps, outputs and /clock included (lockstep); /clock ends at the last step,
         so the nodes' ROS time is the sim time the answer reports."""
-        self.sim.step(count, self._before_updates)
+        while count > 0 and not self._stop.is_set():  # Ctrl-C ends a long request too
+            count -= self.sim.advance(count, self._before_updates)
         if self._last_clock < self.sim.sim_time:
             self._publish_clock(self.sim.sim_time)
         self._restart_pacing()
 
     def run(self, stop: threading.Event):
+        self._stop = stop
         self._restart_pacing()
         while not (stop.is_set() or rospy.is_shutdown()):
             self._serve_requests(block=self.sim.paused)

@@ -34,6 +34,9 @@ from .world_saving import SaveWorldHandler
 _WORLD_FRAMES = ("", "world", "map", "/map")
 # How long a step request waits for the bridge's subscribers to handle what reached them.
 LOCKSTEP_DRAIN_SECONDS = 5.0
+# One step_simulation call covers at most this much sim time: the largest uint32 count would hold the
+# simulator (and every other request) for days.
+MAX_STEP_SIM_SECONDS = 3600.0
 
 
 def _pose_from_message(message: PoseMessage) -> Pose:
@@ -152,6 +155,10 @@ class GazeboRosApi:
             if not self.sim.paused:
                 raise ModelError("StepSimulation: the simulation is running; pause it (or start with "
                                  "lockstep:=true) to step it")
+            most = int(MAX_STEP_SIM_SECONDS / self.sim.step_size)
+            if request.steps > most:
+                raise ModelError(f"StepSimulation: {request.steps} steps is more than one call takes ({most}, "
+                                 f"{MAX_STEP_SIM_SECONDS:.0f} s of sim time); step in parts")
             self.node.step(request.steps)
             return StepSimulationResponse(success=True, sim_time=self.sim.sim_time,
                                           status_message=f"StepSimulation: {request.steps} steps done")

@@ -4,65 +4,20 @@ two-joint arm driven through the controllers in the simulation, with no ROS mast
 import logging
 import math
 import os
-import threading
 
 import pytest
-import yaml
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.geometry import yaw
-from mbot_sim_bridge.core.parameters import Parameters
-from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control.angles import shortest_angular_distance_with_limits
 from mbot_sim_bridge.core.ros_control.control_toolbox import Pid
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveOdometry, SpeedLimiter
 from mbot_sim_bridge.core.ros_control.joint_limits import JointLimits, apply_limit_params
 from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
-from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.core.xml_values import parse_xml
 
-from conftest import WORKSPACE_SRC, expand_xacro
-
-WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
-MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
-ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
-
-
-def load_yaml(path):
-    with open(path) as stream:
-        return yaml.safe_load(stream)
-
-
-def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None):
-    """A Simulation with the robot spawned from ``urdf``, which is also its robot_description parameter; its
-    gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default the
-    model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
-    tree = {"robot_description": urdf}
-    for path, value in [((namespace or name) + "/" + key, config) for key, config in controllers.items()] + list(
-            (parameters or {}).items()):
-        *parents, leaf = path.strip("/").split("/")
-        node = tree
-        for parent in parents:
-            node = node.setdefault(parent, {})
-        node[leaf] = value
-    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS,
-                     parameters=Parameters(tree), package_uris=package_uris)
-    spawned = sim.spawn_robot(parse_robot(package_uris(urdf), f"model '{name}'"), name)
-    plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, GazeboRosControlPlugin))
-    return sim, spawned, plugin
-
-
-def switch(sim, manager, start=(), stop=(), strictness=2):
-    """A switch as the service does it: requested from another thread, performed by the next control update."""
-    result = []
-    thread = threading.Thread(target=lambda: result.append(manager.switch(list(start), list(stop), strictness)))
-    thread.start()
-    while thread.is_alive():
-        sim.step(1)
-    return result[0]
+from conftest import expand_xacro
+from ros_control_fixtures import MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, simulate, switch
 
 
 @pytest.fixture(scope="module")
@@ -302,17 +257,6 @@ def test_wheel_odometry_over_3_m_stays_within_2_percent(mbot):
 
 
 # -- the two-joint arm -------------------------------------------------------------------------------------------
-def arm(interface):
-    urdf = expand_xacro_arm(interface)
-    return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", f"arm_{interface.lower()}.yaml")), "arm")
-
-
-def expand_xacro_arm(interface):
-    import xacro
-    return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
-                              mappings={"interface": interface}).toxml()
-
-
 SETPOINTS = ((0.5, -0.8), (-1.0, 1.2), (1.5, 0.3))
 
 

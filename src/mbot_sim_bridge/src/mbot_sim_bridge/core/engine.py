@@ -34,6 +34,17 @@ _LAST_ROBOT_GROUP_BIT = 30
 
 
 @dataclass
+class BodyState:
+    pose: Tuple[Sequence[float], Sequence[float]]  # centre of mass position, orientation
+    velocity: Tuple[Sequence[float], Sequence[float]]  # linear, angular
+    joints: List[Tuple[float, float]]  # position, velocity by joint index
+
+    @property
+    def finite(self) -> bool:
+        return all(math.isfinite(value) for part in (*self.pose, *self.velocity, *self.joints) for value in part)
+
+
+@dataclass
 class _InitialState:
     position: Tuple[float, float, float]
     orientation: Tuple[float, float, float, float]
@@ -103,6 +114,7 @@ class SpawnedRobot:
         self.collision_group = collision_group
         self.spawn_pose = spawn_pose
         self.driven_joints: Tuple[str, ...] = ()
+        self.loads = 1  # a new body (respawn) has every motor off, whatever a plugin set on the old one
         self.link_index: Dict[str, int] = {model.root: -1}
         self.joint_index: Dict[str, int] = {}
         for index in range(client.getNumJoints(body)):
@@ -234,6 +246,7 @@ class Engine:
     def respawn(self, robot: SpawnedRobot):
         """Load ``robot`` again at its spawn pose after ``restart``; the same object gets the new body."""
         robot.body = self._load_urdf(robot.model, robot.spawn_pose)
+        robot.loads += 1
         self._place(robot, robot.driven_joints)
 
     def _place(self, robot: SpawnedRobot, driven_joints: Optional[Sequence[str]]):
@@ -284,11 +297,44 @@ class Engine:
 
     def reset_world(self):
         """Every model back to its spawn pose and joint positions, at rest (Gazebo's reset_world)."""
-        for body, initial in self._initial.items():
-            self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
-            self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
-            for index, position in initial.joint_positions.items():
-                self.client.resetJointState(body, index, position, 0.0)
+        for body in self._initial:
+            self._restore_initial_state(body)
+
+    def robots_not_finite(self) -> List[str]:
+        """The robots whose base pose the last steps made NaN or infinite. Run after every step, so kept to one
+        state query and one sum per robot (a NaN or inf anywhere makes the sum so)."""
+        state, finite = self.client.getBasePositionAndOrientation, math.isfinite
+        broken = []
+        for name, robot in self.robots.items():
+            position, orientation = state(robot.body)
+            if not finite(sum(position) + sum(orientation)):
+                broken.append(name)
+        return broken
+
+    def body_states(self, names: Sequence[str]) -> Dict[str, "BodyState"]:
+        """These models' base pose and velocity and joint states, to carry them across a ``restart``."""
+        client, states = self.client, {}
+        for name in names:
+            body = self.body_of(name)
+            count = client.getNumJoints(body)
+            joints = client.getJointStates(body, range(count)) if count else []
+            states[name] = BodyState(client.getBasePositionAndOrientation(body), client.getBaseVelocity(body),
+                                     [(position, velocity) for position, velocity, *_ in joints])
+        return states
+
+    def restore_body_state(self, name: str, state: "BodyState"):
+        body = self.body_of(name)
+        self.client.resetBasePositionAndOrientation(body, *state.pose)
+        self.client.resetBaseVelocity(body, *state.velocity)
+        for index, (position, velocity) in enumerate(state.joints):
+            self.client.resetJointState(body, index, position, velocity)
+
+    def _restore_initial_state(self, body: int):
+        initial = self._initial[body]
+        self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
+        self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
+        for index, position in initial.joint_positions.items():
+            self.client.resetJointState(body, index, position, 0.0)
 
     def close(self):
         if self.client is not None:

@@ -8,7 +8,7 @@ ROS layer's registry derived from it, so the core never imports the ROS plugin l
 """
 import hashlib
 from dataclasses import dataclass, field, replace
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
 
 import numpy as np
@@ -75,6 +75,7 @@ class Simulation:
         self._build_order: List[object] = []
         self._plugins: List[Plugin] = []
         self._every_step: List[Plugin] = []
+        self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.add_world(world)
 
@@ -158,6 +159,7 @@ class Simulation:
             for key in [key for key in self._streams if key.startswith(name + "/")]:
                 del self._streams[key]
             self._build_order.remove(name)
+            self._frozen.discard(name)
             self._schedule()
         self.world_models.pop(name, None)
         self.engine.remove(name)
@@ -216,7 +218,8 @@ class Simulation:
                                                   updateRate=repr(self.joint_state_rate))
 
     def _schedule(self):
-        self._plugins = [plugin for spawned in self.models.values() for plugin in spawned.plugins]
+        self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
+                         for plugin in spawned.plugins]
         self._every_step = [plugin for plugin in self._plugins if plugin.needs_every_step]
 
     # -- stepping ------------------------------------------------------------------------------------------------
@@ -232,6 +235,9 @@ class Simulation:
         """Step up to the next plugin event or ``max_steps``, then run the due updates; returns the steps taken."""
         count = max(1, min(max_steps, self.steps_to_next_event()))
         self.engine.step(count)
+        broken = self.engine.robots_not_finite()
+        if broken:
+            self._freeze(broken)
         for plugin in self._every_step:
             self._guarded(plugin, plugin.on_step, self.step_size)
         now = self.sim_time
@@ -243,6 +249,26 @@ class Simulation:
         if self.viewer is not None:
             self.viewer.follow()
         return count
+
+    def _freeze(self, names: Sequence[str]):
+        """Robots whose state the physics made NaN go back to their spawn state with their plugins stopped until
+        a reset. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
+        through the ground, and even a static ground plane reads NaN), so the world is rebuilt with every other
+        moving model's state carried over."""
+        moving = [name for name in self.engine.model_names() if name not in names and not (
+            name in self.world_models and self.world_models[name].static)]
+        kept = {name: state for name, state in self.engine.body_states(moving).items() if state.finite}
+        steps = self.engine.steps
+        self._rebuild()
+        self.engine.steps = steps
+        for name, state in kept.items():
+            self.engine.restore_body_state(name, state)
+        self._frozen.update(names)
+        self._schedule()
+        self.version += 1
+        for name in names:
+            _logger.error(f"model '{name}': the physics step made its state NaN; it is put back at its spawn pose "
+                          "and frozen (its plugins stopped) until reset_world or reset_simulation")
 
     def step(self, count: int, before_updates: Optional[BeforeUpdates] = None):
         """Exactly ``count`` physics steps, with every plugin event on the way."""
@@ -274,6 +300,8 @@ class Simulation:
                 generator.bit_generator.state = np.random.PCG64(sequence).state
         else:
             self.engine.reset_world()
+        self._frozen.clear()
+        self._schedule()
         self.version += 1
         for plugin in list(self._plugins):
             self._guarded(plugin, plugin.reset, self.sim_time)

@@ -6,6 +6,8 @@ from ..log import get_logger, warn_once
 
 _logger = get_logger(__name__)
 
+GAINS = ("p", "i", "d")
+
 
 def clamp(value: float, low: float, high: float) -> float:
     return min(max(value, low), high)
@@ -20,11 +22,20 @@ class Pid:
 
     @classmethod
     def from_params(cls, params, namespace: str, quiet: bool = False) -> Optional["Pid"]:
-        """Pid::init(nh): None (with upstream's error unless quiet) when there is no ``p``."""
+        """Pid::init(nh): None (with upstream's error unless quiet) when there is no ``p``; None with an error
+        naming the gain when a gain is not a finite number (the clamps may be infinite), which upstream takes
+        and which would turn every command into NaN."""
         if not isinstance(params, dict) or "p" not in params:
             if not quiet:
                 _logger.error(f"No p gain specified for pid.  Namespace: {namespace}")
             return None
+        for key in ("p", "i", "d", "i_clamp", "i_clamp_min", "i_clamp_max"):
+            value = params.get(key, 0.0)
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or math.isnan(value) or (key in GAINS and math.isinf(value)):
+                _logger.error(f"{namespace}/{key} is {value!r}: a PID gain must be a finite number"
+                              f"{'' if key in GAINS else ' (or infinite)'}; the PID is not loaded")
+                return None
         i_clamp = abs(float(params.get("i_clamp", 0.0)))
         i_max, i_min = i_clamp, -i_clamp
         if "i_clamp_min" in params:

@@ -1,5 +1,6 @@
 """controller_interface::Controller<T>, and reading a controller's parameters as NodeHandle::param does."""
-from typing import List
+import math
+from typing import List, Sequence
 
 from ..log import get_logger, warn_once
 from .controller_manager import LoadContext
@@ -47,6 +48,16 @@ class Controller:
         if self.INTERFACE != JOINT_STATE and joint not in self.claimed:
             self.claimed.append(joint)
         return handle
+
+    def finite_command(self, joints: Sequence[str], values: Sequence[float]) -> bool:
+        """Whether every value of a command is a finite number. NaN or inf reaching the physics engine would turn
+        the model's state into NaN and disturb every other model, so such a command is ignored, said once."""
+        for joint, value in zip(joints, values):
+            if not math.isfinite(value):
+                warn_once(_logger, f"controller '{self.name}': command {value} for joint '{joint}' is not a finite "
+                                   "number; ignored (the joint keeps its last command)")
+                return False
+        return True
 
     def start_request(self, now: float):
         self.starting(now)

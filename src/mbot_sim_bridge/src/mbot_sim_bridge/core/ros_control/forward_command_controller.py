@@ -5,6 +5,7 @@ from typing import List, Optional, Sequence
 from .controller_manager import ControllerInitError
 from .controller_interface import Controller
 
+
 def joint_name_param(params: dict, namespace: str) -> str:
     joint = params.get("joint")
     if not isinstance(joint, str):
@@ -33,7 +34,8 @@ class ForwardCommandController(Controller):
         self.command = 0.0
 
     def set_command(self, value: float):
-        self.command = value
+        if self.finite_command([self.joint.name], [value]):
+            self.command = value
 
     def starting(self, now):
         self.command = self.joint.position if self.START_AT_POSITION else 0.0
@@ -61,10 +63,12 @@ class ForwardJointGroupCommandController(Controller):
             raise ControllerInitError(f"Exception thrown: {error}") from None
 
     def set_commands(self, values: Sequence[float]) -> Optional[str]:
+        """None when taken or refused for a value that is not finite (said once); else upstream's complaint."""
         if len(values) != len(self.joints):
             return (f"Dimension of command ({len(values)}) does not match number of joints "
                     f"({len(self.joints)})! Not executing!")
-        self.commands = list(values)
+        if self.finite_command(self.joint_names, values):
+            self.commands = list(values)
         return None
 
     def starting(self, now):

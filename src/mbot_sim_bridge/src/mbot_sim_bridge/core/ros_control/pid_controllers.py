@@ -10,6 +10,7 @@ from .hardware_interface import EFFORT
 from .controller_interface import Controller, param
 from .forward_command_controller import ForwardJointGroupCommandController, joint_name_param
 
+
 def _position_error(joint_type: str, current: float, target: float, lower: float, upper: float) -> float:
     if joint_type == "revolute":
         return shortest_angular_distance_with_limits(current, target, lower, upper)
@@ -62,7 +63,8 @@ class PidPositionController(Controller):
         self.error = self.output = 0.0
 
     def set_command(self, position: float, velocity: Optional[float] = None):
-        self.target, self.target_velocity = position, velocity
+        if self.finite_command([self.joint.name] * 2, [position, 0.0 if velocity is None else velocity]):
+            self.target, self.target_velocity = position, velocity
 
     def starting(self, now):
         self.target, self.target_velocity = self.urdf.enforce(self.joint.position), None
@@ -90,7 +92,8 @@ class EffortVelocityController(Controller):
         self.error = self.output = 0.0
 
     def set_command(self, velocity: float):
-        self.target = velocity
+        if self.finite_command([self.joint.name], [velocity]):
+            self.target = velocity
 
     def starting(self, now):
         self.target = 0.0

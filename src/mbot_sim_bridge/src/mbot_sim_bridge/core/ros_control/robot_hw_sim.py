@@ -14,12 +14,14 @@ from ..log import get_logger, info_once, warn_once
 from ..robot_model import RobotModel
 from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
 from .control_toolbox import Pid, clamp
-from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, POSITION, UNBOUNDED_EFFORT, VELOCITY,
-                                 HardwareInterfaceError)
+from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,
+                                 UNBOUNDED_EFFORT, VELOCITY, HardwareInterfaceError)
 from .joint_limits import JointLimits, apply_limit_params, urdf_joint_limits
 from .transmissions import Transmission
 
 _logger = get_logger(__name__)
+
+_COMMAND_KIND = {EFFORT: "effort", POSITION: "position", VELOCITY: "velocity"}
 
 
 @dataclass
@@ -37,7 +39,8 @@ class SimJoint:
     command: float = 0.0
     previous_command: float = math.nan  # position saturation's memory
     previous_velocity_command: float = 0.0  # velocity saturation's memory
-    sent: Optional[Tuple[str, float]] = field(default=None, repr=False)  # last motor setting given to the engine
+    # The last motor setting given to the engine: (the body's load count, mode, value).
+    sent: Optional[Tuple[int, str, float]] = field(default=None, repr=False)
 
     @property
     def lower(self) -> float:
@@ -113,11 +116,13 @@ class DefaultRobotHWSim:
             if interface != EFFORT:
                 # Upstream logs "No p gain specified" as an error for every joint without gains; that is the
                 # normal case (the joint is driven directly), so it is said once at INFO here.
-                pid = Pid.from_params(pid_params.get(joint_name), f"{pid_namespace}/{joint_name}", quiet=True)
+                gains = pid_params.get(joint_name)
+                pid = Pid.from_params(gains, f"{pid_namespace}/{joint_name}", quiet=True)
                 if pid is None:
                     drive = "position servo" if interface == POSITION else "velocity motor"
-                    info_once(_logger, f"{label}: no {pid_namespace}/{joint_name}/p: joint '{joint_name}' is "
-                                       f"driven directly ({drive})")
+                    why = ("its PID gains are refused" if isinstance(gains, dict) and "p" in gains
+                           else f"no {pid_namespace}/{joint_name}/p")
+                    info_once(_logger, f"{label}: {why}: joint '{joint_name}' is driven directly ({drive})")
             self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid)
         self.names = list(self.joints)
 
@@ -165,6 +170,7 @@ class DefaultRobotHWSim:
         for joint in self.joints.values():
             if joint.interface == POSITION and self.e_stop_active:
                 joint.command = self._held_positions.get(joint.name, joint.position)
+            joint.command = self._finite(joint, _COMMAND_KIND[joint.interface], joint.command)
             if joint.limits is not None:
                 self._saturate(joint, period)
             self._drive(joint, period)
@@ -223,12 +229,34 @@ class DefaultRobotHWSim:
         else:
             self._send(joint, "velocity", 0.0 if e_stop else joint.command)
 
+    def _finite(self, joint: SimJoint, what: str, value: float) -> float:
+        """``value``, or the joint held (at its position, or at zero speed or effort) when it is NaN or inf:
+        the engine would make the model's state NaN and disturb every other model."""
+        if math.isfinite(value):
+            return value
+        hold = joint.position if what == "position" else 0.0
+        warn_once(_logger, f"{self.label}: joint '{joint.name}': {what} command {value} is not a finite number; "
+                           f"the joint is held ({hold:g}) until a finite command arrives")
+        return hold
+
+    def _within_engine(self, joint: SimJoint, mode: str, value: float) -> float:
+        """``value`` clamped to what the engine can carry out: joint speeds to its MAX_JOINT_SPEED, efforts to
+        UNBOUNDED_EFFORT (a joint's own limits have been applied before); said once per joint."""
+        bound = MAX_JOINT_SPEED if mode == "velocity" else UNBOUNDED_EFFORT if mode == "effort" else math.inf
+        if abs(value) <= bound:
+            return value
+        warn_once(_logger, f"{self.label}: joint '{joint.name}': {mode} command {value:g} is beyond the engine's "
+                           f"{bound:g}; clamped")
+        return math.copysign(bound, value)
+
     def _send(self, joint: SimJoint, mode: str, value: float):
+        value = self._within_engine(joint, mode, self._finite(joint, mode, value))
         # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is not
         # sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's SetForce).
-        if mode != "effort" and joint.sent == (mode, value):
+        setting = (self.robot.loads, mode, value)
+        if mode != "effort" and joint.sent == setting:
             return
-        joint.sent = (mode, value)
+        joint.sent = setting
         limit = joint.effort_limit if math.isfinite(joint.effort_limit) else UNBOUNDED_EFFORT
         if mode == "effort":
             self.robot.set_joint_effort(joint.name, value)

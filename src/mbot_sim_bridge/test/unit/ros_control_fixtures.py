@@ -1,0 +1,64 @@
+"""Shared builders for the ros_control tests: a Simulation with a robot whose gazebo_ros_control finds its
+controller YAML on a parameter tree, and controller switches as the service performs them."""
+import os
+import threading
+
+import yaml
+
+from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
+from mbot_sim_bridge.core.parameters import Parameters
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.simulation import Simulation
+
+from conftest import WORKSPACE_SRC
+
+WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
+MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
+ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
+
+
+def load_yaml(path):
+    with open(path) as stream:
+        return yaml.safe_load(stream)
+
+
+def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None):
+    """A Simulation with the robot spawned from ``urdf``, which is also its robot_description parameter; its
+    gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default the
+    model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
+    tree = {"robot_description": urdf}
+    for path, value in [((namespace or name) + "/" + key, config) for key, config in controllers.items()] + list(
+            (parameters or {}).items()):
+        *parents, leaf = path.strip("/").split("/")
+        node = tree
+        for parent in parents:
+            node = node.setdefault(parent, {})
+        node[leaf] = value
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS,
+                     parameters=Parameters(tree), package_uris=package_uris)
+    spawned = sim.spawn_robot(parse_robot(package_uris(urdf), f"model '{name}'"), name)
+    plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, GazeboRosControlPlugin))
+    return sim, spawned, plugin
+
+
+def switch(sim, manager, start=(), stop=(), strictness=2):
+    """A switch as the service does it: requested from another thread, performed by the next control update."""
+    result = []
+    thread = threading.Thread(target=lambda: result.append(manager.switch(list(start), list(stop), strictness)))
+    thread.start()
+    while thread.is_alive():
+        sim.step(1)
+    return result[0]
+
+
+def expand_xacro_arm(interface):
+    import xacro
+    return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
+                              mappings={"interface": interface}).toxml()
+
+
+def arm(interface):
+    urdf = expand_xacro_arm(interface)
+    return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", f"arm_{interface.lower()}.yaml")), "arm")

@@ -1,0 +1,175 @@
+"""NaN, inf and huge numbers through ros_control and the physics: the offending robot is refused, clamped or
+frozen with one message, and every other model keeps its pose (before, a NaN wheel command sank them all)."""
+import logging
+import math
+import os
+
+import pytest
+
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.ros_control import CORE_CONTROLLERS
+from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
+
+from conftest import expand_xacro
+from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, switch
+
+BYSTANDER_TOLERANCE = 1e-3  # m
+BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
+
+
+@pytest.fixture(scope="module")
+def mbot_ros_control_urdf():
+    return expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro")
+
+
+def with_bystander(sim, urdf):
+    """A second mbot without plugins two metres away, settled: the model nothing may disturb."""
+    bystander = urdf.replace("libgazebo_ros_control.so", "libnot_simulated.so")
+    sim.spawn_robot(parse_robot(bystander, "model 'bystander'"), "bystander", pose_from_xyz_rpy((2, 0, 0), (0, 0, 0)))
+    sim.step(300)
+    return sim.engine.model_pose("bystander").position
+
+
+def messages(caplog, *texts):
+    return [record for record in caplog.records if all(text in record.getMessage() for text in texts)]
+
+
+ARM_PID = {"p": 100.0, "d": 5.0}
+# Every controller type that takes a command: the robot it drives and its configuration.
+COMMANDED = {
+    "position_controllers/JointPositionController": ("Position", {"joint": "shoulder"}),
+    "position_controllers/JointGroupPositionController": ("Position", {"joints": ["shoulder", "elbow"]}),
+    "velocity_controllers/JointVelocityController": ("mbot", {"joint": "left_wheel_joint"}),
+    "velocity_controllers/JointGroupVelocityController": ("mbot", {"joints": ["left_wheel_joint",
+                                                                             "right_wheel_joint"]}),
+    "velocity_controllers/JointPositionController": ("mbot", {"joint": "left_wheel_joint", "pid": {"p": 10.0}}),
+    "effort_controllers/JointEffortController": ("Effort", {"joint": "shoulder"}),
+    "effort_controllers/JointGroupEffortController": ("Effort", {"joints": ["shoulder", "elbow"]}),
+    "effort_controllers/JointPositionController": ("Effort", {"joint": "shoulder", "pid": ARM_PID}),
+    "effort_controllers/JointVelocityController": ("Effort", {"joint": "shoulder", "pid": ARM_PID}),
+    "effort_controllers/JointGroupPositionController": ("Effort", {"joints": ["shoulder", "elbow"],
+                                                                   "shoulder": {"pid": ARM_PID},
+                                                                   "elbow": {"pid": ARM_PID}}),
+    "diff_drive_controller/DiffDriveController": ("mbot", load_yaml(MBOT_YAML)["mobile_base_controller"]),
+}
+
+
+def test_every_commanded_controller_type_is_fuzzed():
+    assert set(COMMANDED) == set(CORE_CONTROLLERS) - {"joint_state_controller/JointStateController"}
+
+
+def command(sim, controller, value):
+    """``value`` for every joint, as the controller's command topic would carry it; the refusal, if any."""
+    if isinstance(controller, DiffDriveController):
+        return controller.set_command(value, value, sim.sim_time)
+    if hasattr(controller, "set_commands"):
+        return controller.set_commands([value] * len(controller.joints))
+    return controller.set_command(value)
+
+
+@pytest.mark.parametrize("controller_type", sorted(COMMANDED))
+def test_non_finite_and_huge_commands_disturb_no_other_model(mbot_ros_control_urdf, controller_type, caplog):
+    robot, config = COMMANDED[controller_type]
+    urdf = mbot_ros_control_urdf if robot == "mbot" else expand_xacro_arm(robot)
+    name = "mbot" if robot == "mbot" else "arm"
+    sim, spawned, plugin = simulate(urdf, {"fuzzed": dict(config, type=controller_type)}, name,
+                                    namespace="/" if robot == "mbot" else None)  # the mbot's robotNamespace
+    try:
+        resting = with_bystander(sim, mbot_ros_control_urdf)
+        manager = plugin.manager
+        assert manager.load("fuzzed", plugin.urdf) and switch(sim, manager, ["fuzzed"])
+        controller = manager.find("fuzzed").controller
+        for value in BAD_VALUES:
+            complaint = command(sim, controller, value)
+            if not math.isfinite(value):  # refused: said once by the controller, or answered as upstream does
+                said = messages(caplog, "controller 'fuzzed'", f"command {value}", "not a finite number")
+                assert len(said) == 1 or complaint == "Received NaN in velocity command. Ignoring.", value
+            sim.step(300)
+            position = sim.engine.model_pose(name).position
+            assert all(math.isfinite(v) for v in position), (value, position)
+            assert all(math.isfinite(v) for state in spawned.robot.joint_state(spawned.robot.movable_joints)
+                       for v in state), value
+            assert math.dist(sim.engine.model_pose("bystander").position, resting) < BYSTANDER_TOLERANCE, value
+        assert not messages(caplog, "frozen"), "a NaN reached the physics"
+        clamped = [record.getMessage() for record in messages(caplog, "is beyond the engine's")]
+        assert len(clamped) == len(set(clamped))  # once per joint and value
+    finally:
+        sim.close()
+
+
+def effort_arm(shoulder_pid):
+    """The effort-interface two-joint arm with these PID gains for its shoulder position controller."""
+    controllers = load_yaml(os.path.join(ROBOTS, "config", "arm_effort.yaml"))
+    controllers["shoulder_position_controller"]["pid"] = shoulder_pid
+    return simulate(expand_xacro_arm("Effort"), controllers, "arm")
+
+
+@pytest.mark.parametrize("gain, value", [("i", math.inf), ("p", math.nan), ("d", "fast"), ("i_clamp", math.nan)])
+def test_pid_gains_that_are_not_finite_numbers_refuse_the_controller(gain, value, caplog):
+    sim, _, plugin = effort_arm({"p": 1000.0, "i": 500.0, "d": 20.0, "i_clamp": 5.0, gain: value})
+    try:
+        assert not plugin.manager.load("shoulder_position_controller", plugin.urdf)
+        assert messages(caplog, f"shoulder_position_controller/pid/{gain} is {value!r}", "finite number")
+        assert plugin.manager.find("shoulder_position_controller") is None
+    finally:
+        sim.close()
+
+
+def test_a_pid_output_that_overflows_holds_the_joint(caplog):
+    """Finite but absurd gains (p 1e308) overflow the PID's output to inf; the hardware layer holds the joint."""
+    sim, spawned, plugin = effort_arm({"p": 1e308, "d": 1e308})
+    try:
+        manager = plugin.manager
+        assert manager.load("shoulder_position_controller", plugin.urdf)
+        assert switch(sim, manager, ["shoulder_position_controller"])
+        manager.find("shoulder_position_controller").controller.set_command(1.5)
+        sim.step(500)
+        assert all(math.isfinite(v) for state in spawned.robot.joint_state(["shoulder", "elbow"]) for v in state)
+        assert all(math.isfinite(v) for v in sim.engine.model_pose("arm").position)
+        held = [record.getMessage() for record in messages(caplog, "joint 'shoulder'", "not a finite number", "held")]
+        assert held and len(set(held)) == len(held), held  # once for each of inf, -inf
+    finally:
+        sim.close()
+
+
+def test_a_robot_the_physics_turns_nan_is_frozen_and_the_others_keep_their_poses(mbot_ros_control_urdf, caplog):
+    """A NaN that reaches the engine anyway (here a motor set directly, past every guard) is caught at the step."""
+    sim, spawned, plugin = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+    try:
+        resting = with_bystander(sim, mbot_ros_control_urdf)
+        manager = plugin.manager
+        assert manager.load("mobile_base_controller", plugin.urdf)
+        assert switch(sim, manager, ["mobile_base_controller"])
+        spawned.robot.set_joint_velocity("left_wheel_joint", math.nan, 10.0)
+        sim.step(500)
+        assert all(math.isfinite(v) for v in sim.engine.model_pose("mbot").position)
+        assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01, "not put back at its spawn pose"
+        assert math.dist(sim.engine.model_pose("bystander").position, resting) < BYSTANDER_TOLERANCE
+        assert len(messages(caplog, "model 'mbot'", "NaN", "frozen")) == 1
+        # Frozen: its controllers no longer run, so a command does not move it.
+        controller = manager.find("mobile_base_controller").controller
+        controller.set_command(0.3, 0.0, sim.sim_time)
+        sim.step(500)
+        assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01
+        # reset_world lifts the freeze: the same command drives it.
+        sim.reset(simulation=False)
+        for _ in range(10):
+            controller.set_command(0.3, 0.0, sim.sim_time)
+            sim.step(100)
+        assert sim.engine.model_pose("mbot").position[0] > 0.1
+        assert math.dist(sim.engine.model_pose("bystander").position, resting) < BYSTANDER_TOLERANCE
+    finally:
+        sim.close()
+
+
+def test_a_healthy_run_freezes_nothing(mbot_ros_control_urdf, caplog):
+    """The check after every step finds nothing and says nothing in a healthy run."""
+    caplog.set_level(logging.INFO)
+    sim, _, _ = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+    try:
+        sim.step(1000)
+        assert sim.engine.robots_not_finite() == []
+        assert not messages(caplog, "frozen")
+    finally:
+        sim.close()
