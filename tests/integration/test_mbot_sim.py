@@ -38,3 +38,17 @@ def test_sim_runs_until_interrupted(tmp_path):
         assert simulation.wait(timeout=60) == 0, log_path.read_text()
     finally:
         stop_process_group(simulation)
+
+
+def test_sim_refuses_an_argument_the_launch_file_does_not_declare(tmp_path):
+    result = run([MBOT, "sim", "camera", "lockstep:=true"], _environment(tmp_path), timeout=120)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert ("mbot sim: view_mbot_with_camera_gazebo.launch has no argument 'lockstep'; it takes paused, "
+            "use_sim_time, gui, headless, debug") in result.stderr
+
+
+def test_sim_help_lists_each_worlds_arguments(tmp_path):
+    result = run([MBOT, "sim", "--help", "empty"], _environment(tmp_path), timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "lockstep:=false    start paused; the simulation moves only through /gazebo/step_simulation" in result.stdout
+    assert "world_name:=" in result.stdout and "x:=0    spawn x (m)" in result.stdout

@@ -10,6 +10,7 @@ import threading
 import time
 
 import roslaunch
+import roslaunch.arg_dump
 import roslaunch.parent
 import roslaunch.pmon
 import roslaunch.rlutil
@@ -32,17 +33,36 @@ class ServerWatch(roslaunch.pmon.ProcessListener):
             self.died.set()
 
 
+def arguments_help(launch_file: str, declared: dict) -> str:
+    """The arguments a launch file lets the command line set (those with a default), with their docs."""
+    lines = [f"{launch_file} takes:"]
+    for name, (doc, default) in declared.items():
+        shown = default if default else "''"
+        lines.append(f"  {name}:={shown}" + (f"    {doc}" if doc else ""))
+    return "\n".join(lines)
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) < 2:
-        print("usage: mbot_sim_launch PACKAGE FILE.launch [name:=value ...]", file=sys.stderr)
+        print("usage: mbot_sim_launch PACKAGE FILE.launch [name:=value ... | --help]", file=sys.stderr)
         return 2
     package, launch_file, launch_args = argv[0], argv[1], argv[2:]
     try:
         path = roslaunch.rlutil.resolve_launch_arguments([package, launch_file])[0]
+        declared = roslaunch.arg_dump.get_args([path])
     except roslaunch.RLException as error:
         print(f"mbot sim: {error}", file=sys.stderr)
         return 1
+    if launch_args == ["--help"]:
+        print(arguments_help(launch_file, declared))
+        return 0
+    # roslaunch ignores an argument the file does not declare: a typo or a wrong world would pass unnoticed.
+    unknown = [name for name in (argument.split(":=", 1)[0] for argument in launch_args) if name not in declared]
+    if unknown:
+        print(f"mbot sim: {launch_file} has no argument '{unknown[0]}'; it takes {', '.join(declared)} "
+              "(./mbot sim --help WORLD says what each does)", file=sys.stderr)
+        return 2
     run_id = roslaunch.rlutil.get_or_generate_uuid(None, False)
     roslaunch.configure_logging(run_id)
     watch = ServerWatch()

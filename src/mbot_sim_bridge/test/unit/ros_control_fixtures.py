@@ -12,8 +12,7 @@ from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
-from conftest import WORKSPACE_SRC
-
+WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
 MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
 ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")

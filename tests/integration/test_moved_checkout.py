@@ -1,0 +1,38 @@
+"""A checkout moved (or copied) to another folder works after ``./mbot setup``: the venv's and the devel space's
+scripts name the folder they were made in, so setup notices the move and makes them again."""
+import os
+import shutil
+import subprocess
+
+import pytest
+
+from ros_processes import TESTS, run
+
+pytestmark = pytest.mark.long
+
+CHECKOUT = os.path.dirname(TESTS)
+# What was built in the old folder comes along; the venv is left behind to keep the copy small (setup makes it
+# again in either case).
+COPIED = (".catkin_workspace", "mbot", "requirements.txt", "src", "worlds", "build", "devel")
+
+
+def test_a_moved_checkout_is_rebuilt_by_setup(tmp_path):
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    for name in COPIED:
+        source = os.path.join(CHECKOUT, name)
+        if os.path.isdir(source):
+            shutil.copytree(source, moved / name, symlinks=True, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            shutil.copy2(source, moved / name)
+    environment = {key: value for key, value in os.environ.items()
+                   if not key.startswith(("ROS", "CMAKE_PREFIX", "PYTHONPATH", "VIRTUAL_ENV"))}
+    setup = run([str(moved / "mbot"), "setup"], environment, timeout=600)
+    assert setup.returncode == 0, setup.stdout + setup.stderr
+    assert f"the checkout moved from {CHECKOUT}" in setup.stdout + setup.stderr
+    script = moved / "devel" / "lib" / "mbot_gazebo" / "mbot_sim_launch"
+    assert script.read_text().splitlines()[0] == f"#!{moved}/.venv/bin/python3"
+    assert subprocess.run(["grep", "-rl", CHECKOUT, str(moved / "devel"), str(moved / ".venv" / "bin")],
+                          capture_output=True, text=True).stdout == "", "files still name the old folder"
+    listed = run([str(moved / "mbot"), "sim", "--help", "empty"], environment, timeout=120)
+    assert listed.returncode == 0 and "lockstep:=false" in listed.stdout, listed.stdout + listed.stderr
