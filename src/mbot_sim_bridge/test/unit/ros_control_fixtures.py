@@ -61,3 +61,12 @@ def expand_xacro_arm(interface):
 def arm(interface):
     urdf = expand_xacro_arm(interface)
     return simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", f"arm_{interface.lower()}.yaml")), "arm")
+
+
+def start_controllers(sim, plugin, *names):
+    """Load and start the controllers ``names`` as the spawner does; returns the first one's controller."""
+    manager = plugin.manager
+    for name in names:
+        assert manager.load(name, plugin.urdf), f"{name} did not load"
+    assert switch(sim, manager, list(names))
+    return manager.find(names[0]).controller

@@ -12,7 +12,7 @@ from mbot_sim_bridge.core.ros_control import CORE_CONTROLLERS
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
 
 from conftest import expand_xacro
-from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, switch
+from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, start_controllers
 
 BYSTANDER_TOLERANCE = 1e-3  # m
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
@@ -77,9 +77,7 @@ def test_non_finite_and_huge_commands_disturb_no_other_model(mbot_ros_control_ur
                                     namespace="/" if robot == "mbot" else None)  # the mbot's robotNamespace
     try:
         resting = with_bystander(sim, mbot_ros_control_urdf)
-        manager = plugin.manager
-        assert manager.load("fuzzed", plugin.urdf) and switch(sim, manager, ["fuzzed"])
-        controller = manager.find("fuzzed").controller
+        controller = start_controllers(sim, plugin, "fuzzed")
         for value in BAD_VALUES:
             complaint = command(sim, controller, value)
             if not math.isfinite(value):  # refused: said once by the controller, or answered as upstream does
@@ -120,10 +118,7 @@ def test_a_pid_output_that_overflows_holds_the_joint(caplog):
     """Finite but absurd gains (p 1e308) overflow the PID's output to inf; the hardware layer holds the joint."""
     sim, spawned, plugin = effort_arm({"p": 1e308, "d": 1e308})
     try:
-        manager = plugin.manager
-        assert manager.load("shoulder_position_controller", plugin.urdf)
-        assert switch(sim, manager, ["shoulder_position_controller"])
-        manager.find("shoulder_position_controller").controller.set_command(1.5)
+        start_controllers(sim, plugin, "shoulder_position_controller").set_command(1.5)
         sim.step(500)
         assert all(math.isfinite(v) for state in spawned.robot.joint_state(["shoulder", "elbow"]) for v in state)
         assert all(math.isfinite(v) for v in sim.engine.model_pose("arm").position)
@@ -138,9 +133,7 @@ def test_a_robot_the_physics_turns_nan_is_frozen_and_the_others_keep_their_poses
     sim, spawned, plugin = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
     try:
         resting = with_bystander(sim, mbot_ros_control_urdf)
-        manager = plugin.manager
-        assert manager.load("mobile_base_controller", plugin.urdf)
-        assert switch(sim, manager, ["mobile_base_controller"])
+        controller = start_controllers(sim, plugin, "mobile_base_controller")
         spawned.robot.set_joint_velocity("left_wheel_joint", math.nan, 10.0)
         sim.step(500)
         assert all(math.isfinite(v) for v in sim.engine.model_pose("mbot").position)
@@ -148,7 +141,6 @@ def test_a_robot_the_physics_turns_nan_is_frozen_and_the_others_keep_their_poses
         assert math.dist(sim.engine.model_pose("bystander").position, resting) < BYSTANDER_TOLERANCE
         assert len(messages(caplog, "model 'mbot'", "NaN", "frozen")) == 1
         # Frozen: its controllers no longer run, so a command does not move it.
-        controller = manager.find("mobile_base_controller").controller
         controller.set_command(0.3, 0.0, sim.sim_time)
         sim.step(500)
         assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01

@@ -17,7 +17,8 @@ from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
 from mbot_sim_bridge.core.xml_values import parse_xml
 
 from conftest import expand_xacro
-from ros_control_fixtures import MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, simulate, switch
+from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, simulate, start_controllers,
+                                  switch)
 
 
 @pytest.fixture(scope="module")
@@ -288,10 +289,7 @@ def test_effort_limits_saturate_the_pid_output(caplog):
     caplog.set_level(logging.INFO)
     sim, _, plugin = arm("Effort")
     try:
-        manager = plugin.manager
-        assert manager.load("shoulder_position_controller", plugin.urdf)
-        assert switch(sim, manager, ["shoulder_position_controller"])
-        manager.find("shoulder_position_controller").controller.set_command(1.9)
+        start_controllers(sim, plugin, "shoulder_position_controller").set_command(1.9)
         sim.step(2)
         assert plugin.hw.joints["shoulder"].command == pytest.approx(40.0)  # the URDF's effort limit
         assert "mechanicalReduction" not in caplog.text  # a reduction of 1 needs no remark
