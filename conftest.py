@@ -75,8 +75,16 @@ def pytest_configure(config):
     config.rostest_nodes = _rostest_nodes()
 
 
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
 def pytest_collection_modifyitems(items):
+    """Long modules first; with ``--dist loadgroup`` every test goes to whichever worker is free, except that a
+    module's tests that share a module- or class-scoped fixture (one simulator, one build) stay together."""
     items.sort(key=lambda item: item.get_closest_marker("long") is None)
+    for item in items:
+        fixtures = getattr(item, "_fixtureinfo", None)
+        definitions = fixtures.name2fixturedefs.values() if fixtures else ()
+        if any(definition.scope in ("module", "class") for chain in definitions for definition in chain):
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
 
 
 def pytest_ignore_collect(collection_path, config):

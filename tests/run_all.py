@@ -16,7 +16,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REPORT = os.path.join(ROOT, "build", "test_results", "pytest.xml")
 TEST_ROOTS = ("src/*/test", "tests")
 # Most tests wait on ROS processes rather than compute, so twice as many workers as cores keep both busy;
-# module-scoped fixtures (one simulator shared by a module's tests) stay on one worker with --dist loadscope.
+# --dist loadgroup hands out tests one by one, keeping together those that share a module-scoped fixture (one
+# simulator shared by a module's tests; see the workspace's conftest.py).
 WORKERS = 2 * (os.cpu_count() or 1)
 
 
@@ -52,7 +53,7 @@ def main(arguments):
     roots = [path for pattern in TEST_ROOTS for path in sorted(glob.glob(os.path.join(ROOT, pattern)))]
     paths_given = any(not argument.startswith("-") and os.path.exists(argument) for argument in arguments)
     command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--rootdir", ROOT,
-               "--junitxml", REPORT, "-n", str(WORKERS), "--dist", "loadscope", "--durations", "10",
+               "--junitxml", REPORT, "-n", str(WORKERS), "--dist", "loadgroup", "--durations", "10",
                *arguments, *([] if paths_given else roots)]
     code = subprocess.call(command, cwd=ROOT)
     if code == 5:  # nothing selected by the filter
