@@ -64,6 +64,32 @@ class RosControlArms(unittest.TestCase):
             self.figures.append(f"effort arm (effort_controllers/JointPositionController) at {setpoint} rad: errors "
                                 f"{errors[0]:.3f}, {errors[1]:.3f} degrees")
 
+    def test_non_finite_commands_on_the_topics_are_ignored(self):
+        """NaN and inf on the command topics leave both arms where they were; 1e308 is taken as the joint limit."""
+        shoulder = rospy.Publisher("/effort_arm/shoulder_position_controller/command", Float64, queue_size=1,
+                                   latch=True)
+        group = rospy.Publisher("/position_arm/arm_controller/command", Float64MultiArray, queue_size=1, latch=True)
+        shoulder.publish(Float64(0.5))
+        group.publish(Float64MultiArray(data=[0.5, -0.8]))
+        self.reach("effort_arm", (0.5, self.positions("effort_arm")["elbow"]))
+        self.reach("position_arm", (0.5, -0.8))
+        for value in (math.nan, math.inf, -math.inf):
+            shoulder.publish(Float64(value))
+            group.publish(Float64MultiArray(data=[value, value]))
+            start = rospy.get_time()
+            wait_for(lambda: rospy.get_time() > start + 0.5, what="0.5 s of sim time")
+            self.assertAlmostEqual(self.positions("effort_arm")["shoulder"], 0.5, delta=math.radians(TOLERANCE_DEGREES))
+            self.assertLess(max(self.errors("position_arm", (0.5, -0.8))), TOLERANCE_DEGREES, value)
+        # Taken as the URDF's upper limit, 2.0 rad; the 40 N m shoulder holds the arm against gravity at 1.9.
+        shoulder.publish(Float64(1e308))
+        wait_for(lambda: self.positions("effort_arm")["shoulder"] > 1.5, timeout=WALL_TIMEOUT,
+                 what="the effort arm's shoulder on its way to the upper limit")
+        self.assertTrue(all(math.isfinite(v) for arm in self.states.values() for v in arm.position + arm.velocity))
+
+    def positions(self, arm):
+        state = self.states[arm]
+        return dict(zip(state.name, state.position))
+
     def test_position_arm_through_the_forward_group_controller(self):
         command = rospy.Publisher("/position_arm/arm_controller/command", Float64MultiArray, queue_size=1,
                                   latch=True)
