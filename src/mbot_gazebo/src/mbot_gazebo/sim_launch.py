@@ -5,6 +5,7 @@ That is gazebo_ros's ``server_required:=true`` for the workspace's own launch fi
 a bad world or robot stops the whole launch with the simulator's one-line error and a non-zero status,
 instead of leaving robot_state_publisher and the spawner running on.
 """
+import os
 import sys
 import threading
 import time
@@ -55,7 +56,10 @@ def main(argv=None):
         print(f"mbot sim: {error}", file=sys.stderr)
         return 1
     if launch_args == ["--help"]:
-        print(arguments_help(launch_file, declared))
+        try:
+            print(arguments_help(launch_file, declared), flush=True)
+        except BrokenPipeError:  # `| head` has read what it wanted; Python's exit would complain on the flush
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     # roslaunch ignores an argument the file does not declare: a typo or a wrong world would pass unnoticed.
     unknown = [name for name in (argument.split(":=", 1)[0] for argument in launch_args) if name not in declared]
