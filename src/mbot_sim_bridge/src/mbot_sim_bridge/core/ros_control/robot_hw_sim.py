@@ -221,7 +221,9 @@ class DefaultRobotHWSim:
             else:
                 error = -joint.velocity if e_stop else joint.command - joint.velocity
             limit = joint.effort_limit
-            self._send(joint, "effort", clamp(joint.pid.compute(error, period), -limit, limit))
+            # The one value not checked by write_sim: gains like 1e308 overflow it, past an unbounded limit.
+            effort = self._finite(joint, "effort", joint.pid.compute(error, period))
+            self._send(joint, "effort", clamp(effort, -limit, limit))
         elif joint.interface == EFFORT:
             self._send(joint, "effort", 0.0 if e_stop else joint.command)
         elif joint.interface == POSITION:
@@ -250,7 +252,7 @@ class DefaultRobotHWSim:
         return math.copysign(bound, value)
 
     def _send(self, joint: SimJoint, mode: str, value: float):
-        value = self._within_engine(joint, mode, self._finite(joint, mode, value))
+        value = self._within_engine(joint, mode, value)  # finite: write_sim and _drive have seen to that
         # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is not
         # sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's SetForce).
         setting = (self.robot.loads, mode, value)
