@@ -17,7 +17,9 @@ import time
 import warnings
 from collections import defaultdict
 from typing import Dict, List, Tuple
+from xmlrpc.client import ServerProxy
 
+import rosgraph
 import rospy
 from mbot_sim_msgs.srv import StepSimulation
 
@@ -54,6 +56,21 @@ class Recorder:
             subscriber.unregister()
 
 
+def _publishers_sending(topic: str) -> int:
+    """How many of ``topic``'s publishers list an outbound connection to this node (their getBusInfo)."""
+    me = rospy.get_caller_id()
+    master = rosgraph.Master(me)
+    publishers = next((nodes for name, nodes in master.getSystemState()[0] if name == topic), [])
+    sending = 0
+    for node in publishers:
+        try:
+            code, _, connections = ServerProxy(master.lookupNode(node)).getBusInfo(me)
+        except (OSError, rosgraph.MasterError):
+            continue  # gone, or not yet registered: counted on a later look
+        sending += code == 1 and any(info[1] == me and info[2] == "o" and info[4] == topic for info in connections)
+    return sending
+
+
 class LockstepClient:
     def __init__(self, gazebo_namespace: str = "/gazebo", timeout: float = 60.0):
         self.timeout = timeout
@@ -77,6 +94,9 @@ class LockstepClient:
             wanted = (publishers or {}).get(topic, 1)
             self._wait(lambda: subscriber.subscriber.get_num_connections() >= wanted,
                        f"{topic} to have {wanted} publishers")
+            # This side counts a connection as soon as it has one; a publisher counts it a little later, and the
+            # bridge skips publishing to nobody. Under load that gap swallowed a run's first messages.
+            self._wait(lambda: _publishers_sending(topic) >= wanted, f"{topic}'s publishers to count this node")
         self._recorders.append(recorder)
         return recorder
 
