@@ -16,4 +16,6 @@ def resolve_package_uris(xml: str) -> str:
             return packages.get_path(match.group(1)) + "/"
         except rospkg.ResourceNotFound:
             raise ModelError(f"package://{match.group(1)}/ in the model: no such package") from None
-    return re.sub(r"package://([^/]+)/", replace, xml)
+    # Only a package name (letters, digits, '_', '-', '.') counts: gazebo_ros takes whatever precedes the next '/',
+    # so a "package:// ..." in an XML comment refused the whole model with a garbled name.
+    return re.sub(r"package://([\w.-]+)/", replace, xml)

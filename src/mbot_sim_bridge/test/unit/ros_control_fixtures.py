@@ -1,11 +1,13 @@
 """Shared builders for the ros_control tests: a Simulation with a robot whose gazebo_ros_control finds its
 controller YAML on a parameter tree, and controller switches as the service performs them."""
+import math
 import os
 import threading
 
 import yaml
 
 from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
+from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
@@ -70,3 +72,24 @@ def start_controllers(sim, plugin, *names):
         assert manager.load(name, plugin.urdf), f"{name} did not load"
     assert switch(sim, manager, list(names))
     return manager.find(names[0]).controller
+
+
+def measured_motion(sim, spawned, controller, linear, angular, settle=1.5, window=1.0):
+    """Command (re-sent well within cmd_vel_timeout), settle, then ground truth over a window: the mean forward
+    speed in the robot's own frame (a chord would shorten arcs) and the heading change per second."""
+    forward_speeds = []
+
+    def run(seconds, record):
+        for _ in range(int(round(seconds / 0.05))):
+            controller.set_command(linear, angular, sim.sim_time)
+            sim.step(50)
+            if record:
+                velocity, _ = spawned.robot.root_velocity()
+                heading = yaw(spawned.robot.root_pose().orientation)
+                forward_speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
+    run(settle, False)
+    start, heading0 = sim.sim_time, yaw(spawned.robot.root_pose().orientation)
+    run(window, True)
+    dt = sim.sim_time - start
+    return (sum(forward_speeds) / len(forward_speeds),
+            math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi) / dt)

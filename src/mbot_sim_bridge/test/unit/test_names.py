@@ -4,7 +4,7 @@ from mbot_sim_bridge.core import names
 from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 
-# Gazebo file name -> (absent, empty, given) for a model called "bot"; from gazebo_plugins' sources (Noetic).
+# Gazebo file name -> (absent, empty, given) for a model called "bot"; from the plugins' sources.
 EXPECTED = dict([
     ("libgazebo_ros_diff_drive.so", ("bot", "bot", "r1")),
     ("libgazebo_ros_joint_state_publisher.so", ("bot", "bot", "r1")),
@@ -17,6 +17,12 @@ EXPECTED = dict([
     ("libgazebo_ros_imu.so", ("/", "/", "r1")),
     ("libgazebo_ros_p3d.so", ("/", "/", "r1")),
     ("libgazebo_ros_imu_sensor.so", ("/bot", "/", "r1")),
+    ("libgazebo_ros_planar_move.so", ("/", "/", "r1")),
+    # hector_gazebo_plugins (melodic-devel) and velodyne_simulator (1.0.13): NodeHandle(tag or "" / "/").
+    ("libhector_gazebo_ros_imu.so", ("/", "/", "r1")),
+    ("libhector_gazebo_ros_gps.so", ("/", "/", "r1")),
+    ("libgazebo_ros_velodyne_laser.so", ("/", "/", "r1")),
+    ("libgazebo_ros_velodyne_gpu_laser.so", ("/", "/", "r1")),
 ])
 
 

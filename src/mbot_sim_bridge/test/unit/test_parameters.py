@@ -30,6 +30,11 @@ def test_package_uris_resolve_to_the_package_folder():
     assert "package://" not in resolved and resolved.endswith("mbot_description/urdf/x.stl'/>")
 
 
+def test_package_uris_in_comments_are_left_alone():
+    text = "<!-- meshes are package:// URIs --><mesh filename='package://mbot_description/m.stl'/>"
+    assert resolve_package_uris(text).startswith("<!-- meshes are package:// URIs --><mesh filename='/")
+
+
 ARM = """<robot name="meshy">
   <link name="base"><inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/>
     </inertial><collision><geometry><mesh filename="package://meshes_pkg/block.stl"/></geometry></collision></link>

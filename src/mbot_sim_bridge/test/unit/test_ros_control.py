@@ -8,7 +8,6 @@ import os
 import pytest
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.ros_control.angles import shortest_angular_distance_with_limits
 from mbot_sim_bridge.core.ros_control.control_toolbox import Pid
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveOdometry, SpeedLimiter
@@ -17,8 +16,8 @@ from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
 from mbot_sim_bridge.core.xml_values import parse_xml
 
 from conftest import expand_xacro
-from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, simulate, start_controllers,
-                                  switch)
+from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, measured_motion, simulate,
+                                  start_controllers, switch)
 
 
 @pytest.fixture(scope="module")
@@ -206,22 +205,6 @@ def test_unknown_type_missing_type_and_unknown_joint_fail_with_upstream_texts(mb
 
 
 # -- the mbot through diff_drive_controller ----------------------------------------------------------------------
-def measured_motion(sim, spawned, controller, linear, angular, settle=1.5, window=1.0):
-    """Command (re-sent well within cmd_vel_timeout), settle, then ground truth over a window."""
-    def run(seconds):
-        for _ in range(int(round(seconds / 0.05))):
-            controller.set_command(linear, angular, sim.sim_time)
-            sim.step(50)
-    run(settle)
-    start, pose0 = sim.sim_time, spawned.robot.root_pose()
-    run(window)
-    pose1, dt = spawned.robot.root_pose(), sim.sim_time - start
-    heading = yaw(pose0.orientation)
-    dx, dy = (pose1.position[i] - pose0.position[i] for i in range(2))
-    return ((dx * math.cos(heading) + dy * math.sin(heading)) / dt,
-            math.remainder(yaw(pose1.orientation) - heading, 2 * math.pi) / dt)
-
-
 @pytest.mark.parametrize("linear", [0.2, -0.2])
 def test_the_mbot_tracks_linear_speed(mbot, linear):
     sim, spawned, _, controller = mbot

@@ -156,6 +156,11 @@ class SpawnedRobot:
         state = self.client.getLinkState(self.body, index, computeLinkVelocity=True)
         return _point_velocity(state[0], state[6], state[7], point)
 
+    def set_root_velocity(self, linear: Sequence[float], angular: Sequence[float]):
+        """The base's world-frame velocity (of its centre of mass), as Gazebo's Model::SetLinearVel and
+        SetAngularVel set the canonical link's."""
+        self.client.resetBaseVelocity(self.body, linear, angular)
+
     def set_joint_velocity(self, joint_name: str, velocity: float, max_force: float):
         """A velocity motor, as Gazebo's ODE joint 'vel' + 'fmax' pair."""
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.VELOCITY_CONTROL,
@@ -193,7 +198,10 @@ class Engine:
         self.client.setTimeStep(self.physics.max_step_size)
         self.client.setGravity(*self.physics.gravity)
         # Same inputs, same contacts: keeps two runs (and two tests) identical.
-        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        # Friction along two tangent directions, as ODE's pyramid model that Gazebo uses: Bullet's default cone
+        # friction made four-wheel skid-steer bases turn in place by fits and starts (yaw rate 0.08 to 0.8 rad/s
+        # for a steady 0.8 command).
+        self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1, enableConeFriction=0)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -370,16 +378,27 @@ class Engine:
             self._set_surface(robot, link_name, index, caster=link_name in casters)
 
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
-        link = robot.model.links.get(link_name)
         mu = DEFAULT_MU
-        if link is not None:
+        # sdformat keeps a lumped link's <gazebo reference> surface on the collisions it brings to its parent
+        # (a base_link lumped into a base_footprint root keeps its mu); Bullet has one friction per link.
+        frictions = {}
+        for name, (body_link, _) in robot.model.lumped_into.items():
+            link = robot.model.links.get(name)
+            if body_link != link_name or link is None or (name != link_name and not link.collision_kinds):
+                continue
             mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
-            values = [_friction(v, robot.name, link_name) for v in (mu1, mu2) if v is not None]
+            values = [_friction(v, robot.name, name) for v in (mu1, mu2) if v is not None]
             if len(values) == 2 and values[0] != values[1]:
-                warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1} and mu2 {mu2}; Bullet's friction "
+                warn_once(_logger, f"{robot.name}: link '{name}' has mu1 {mu1} and mu2 {mu2}; Bullet's friction "
                                    "is isotropic, the smaller is used")
             if values:
-                mu = min(values)
+                frictions[name] = min(values)
+        if len(set(frictions.values())) > 1:
+            warn_once(_logger, f"{robot.name}: links lumped into '{link_name}' have different friction ("
+                               f"{', '.join(f'{name} {value:g}' for name, value in sorted(frictions.items()))}); "
+                               "Bullet has one per link, the smallest is used")
+        if frictions:
+            mu = min(frictions.values())
         if caster:
             mu = 0.0
         self.client.changeDynamics(robot.body, index, lateralFriction=mu, spinningFriction=0.0,

@@ -8,10 +8,14 @@ from typing import Dict
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
 from .gazebo_ros_control import GazeboRosControlPlugin
+from .hector_gps import HectorGps
+from .hector_imu import HectorImu
 from .imu import ImuModelPlugin, ImuSensor
 from .joint_states import JointStatePublisher
 from .lidar import RaySensor
 from .p3d import P3D
+from .planar_move import PlanarMove
+from .velodyne_laser import VelodyneLaser
 
 CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_control.so": GazeboRosControlPlugin,
@@ -25,6 +29,11 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_imu.so": ImuModelPlugin,
     "libgazebo_ros_imu_sensor.so": ImuSensor,
     "libgazebo_ros_p3d.so": P3D,
+    "libgazebo_ros_planar_move.so": PlanarMove,
+    "libhector_gazebo_ros_imu.so": HectorImu,
+    "libhector_gazebo_ros_gps.so": HectorGps,
+    "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
+    "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,
 }
 
 

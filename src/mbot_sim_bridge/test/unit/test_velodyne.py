@@ -1,0 +1,92 @@
+"""Velodyne's lidar plugins (core/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
+in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
+import math
+import os
+
+import numpy as np
+import pytest
+import xacro
+from sensor_fixtures import box, plugin_of, world_simulation
+
+from mbot_sim_bridge.core.geometry import Pose
+from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.velodyne_laser import VelodyneLaser
+
+ROBOTS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots")
+STAND = """<robot name="stand" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:include filename="{macro}"/>
+  <link name="base_link">
+    <inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.25"/><geometry><box size="0.3 0.3 0.5"/></geometry></collision>
+  </link>
+  <xacro:VLP-16 parent="base_link" name="velodyne" topic="velodyne_points" hz="10" samples="440" noise="{noise}"
+                organize_cloud="{organize}">
+    <origin xyz="0 0 0.5" rpy="0 0 0"/>
+  </xacro:VLP-16>
+</robot>"""
+WALL_X = 3.0
+# The scan frame: 0.5 m mount plus 37.7 mm.
+SENSOR_Z = 0.5377
+
+
+def velodyne(tmp_path, noise=0.0, organize=False):
+    path = tmp_path / "stand.urdf.xacro"
+    path.write_text(STAND.format(macro=os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro")),
+                                 noise=noise, organize=str(organize).lower()))
+    sim = world_simulation(tmp_path, box("wall", (WALL_X + 0.05, 0.0, 1.5), (0.1, 20.0, 3.0)))
+    urdf = xacro.process_file(str(path)).toxml()
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand", Pose((0.0, 0.0, 0.0), (0, 0, 0, 1)))
+    sim.step(10)
+    return sim, plugin_of(spawned, VelodyneLaser)
+
+
+def test_sixteen_rings_lowest_first_and_points_on_the_wall(tmp_path):
+    _, lidar = velodyne(tmp_path)
+    cloud = lidar.cloud()
+    assert sorted(set(cloud.ring.tolist())) == list(range(16))
+    ahead = (np.abs(np.arctan2(cloud.xyz[:, 1], cloud.xyz[:, 0])) < 0.5) & (cloud.xyz[:, 2] + SENSOR_Z > 0.02)
+    wall = cloud.xyz[ahead]
+    error = np.abs(wall[:, 0] - WALL_X).max()
+    print(f"figure: VLP-16-style lidar: {len(cloud.ring)} points, 16 rings; {len(wall)} on the wall 3 m ahead "
+          f"within {error * 100:.2f} cm")
+    assert len(wall) > 500 and error < 0.02
+    lowest = cloud.xyz[cloud.ring == 0]
+    assert np.all(lowest[:, 2] < 0)  # ring 0 looks 15 degrees down
+    # Ring j's points lie on its cone: pitch = -15 + 2j degrees.
+    pitch = np.degrees(np.arctan2(cloud.xyz[:, 2], np.hypot(cloud.xyz[:, 0], cloud.xyz[:, 1])))
+    assert pitch == pytest.approx(-15.0 + 2.0 * cloud.ring, abs=0.01)
+
+
+def test_readings_beyond_the_limits_are_dropped_or_nan_when_organised(tmp_path):
+    _, lidar = velodyne(tmp_path)
+    dense = lidar.cloud()
+    assert not dense.organized and np.all(np.isfinite(dense.xyz))
+    ranges = np.linalg.norm(dense.xyz, axis=1)
+    assert ranges.min() > 0.9 and ranges.max() < 130.0
+    _, organised_lidar = velodyne(tmp_path, organize=True)
+    organised = organised_lidar.cloud()
+    assert organised.organized and len(organised.ring) == 16 * 440 and organised.rows == 440
+    # Listed column by column, as the driver lists them: each row is one direction, rings 0..15.
+    assert organised.ring[:32].tolist() == list(range(16)) * 2
+    # The upper rings see nothing beyond the wall's top in some directions: NaN there, and the same
+    # valid points as the dense cloud.
+    assert np.isnan(organised.xyz).any()
+    assert np.count_nonzero(np.isfinite(organised.xyz[:, 0])) == len(dense.ring)
+
+
+def test_noise_is_added_to_the_range_and_reruns_identically(tmp_path):
+    _, lidar = velodyne(tmp_path, noise=0.01)
+    _, again = velodyne(tmp_path, noise=0.01)
+    first, second = lidar.cloud(), again.cloud()
+    assert np.array_equal(first.xyz, second.xyz)
+    ahead = np.abs(first.xyz[:, 1]) < 0.3
+    spread = (first.xyz[ahead, 0] - WALL_X)[first.xyz[ahead, 2] > -SENSOR_Z + 0.05]
+    assert np.std(spread) == pytest.approx(0.01, rel=0.3)
+
+
+def test_the_pointcloud2_layout_is_velodyne_pointclouds():
+    from mbot_sim_bridge.plugins.gazebo_ros_velodyne_laser import FIELDS, POINT
+    assert [(f.name, f.offset, f.datatype) for f in FIELDS] == [
+        ("x", 0, 7), ("y", 4, 7), ("z", 8, 7), ("intensity", 12, 7), ("ring", 16, 4), ("time", 18, 7)]
+    assert POINT.itemsize == 22
+    assert math.isclose(np.frombuffer(np.zeros(1, POINT).tobytes(), np.uint8).size, 22)

@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""The rover as its own launch file brings it up: both controllers start; the base, whose collision meshes are
+package:// STL and COLLADA files, drives at the commanded speed (ground truth); the hector IMU reads gravity up
+at rest; the hector GPS fix moves north by the distance driven (x is north at referenceHeading 0); the
+VLP-16-style lidar publishes 16 rings. A holonomic base beside it (planar move) moves sideways at the
+commanded speed and its odometry says so."""
+import math
+import unittest
+
+import rospy
+import rostest
+from controller_manager_msgs.srv import ListControllers
+from gazebo_msgs.srv import GetModelState
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, NavSatFix, PointCloud2
+from sensor_msgs import point_cloud2
+
+from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for
+
+CONTROLLER = "rover_velocity_controller"
+# WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
+EQUATORIAL_RADIUS, EXCENTRICITY2 = 6378137.0, 0.00669437999013
+REFERENCE_LATITUDE = math.radians(49.9)
+
+
+def north_radius():
+    sin2 = math.sin(REFERENCE_LATITUDE) ** 2
+    return EQUATORIAL_RADIUS * (1 - EXCENTRICITY2) / (1 - EXCENTRICITY2 * sin2) ** 1.5
+
+
+class Latest:
+    """The messages of a topic, the last one first at hand."""
+
+    def __init__(self, topic, message_type):
+        self.message, self.messages = None, []
+        self.subscriber = rospy.Subscriber(topic, message_type, self.store, queue_size=100)
+
+    def store(self, message):
+        self.message = message
+        self.messages.append(message)
+
+    def since(self, stamp):
+        return [message for message in self.messages if message.header.stamp >= stamp]
+
+
+class Rover(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("rover_test")
+        cls.figures = []
+        rospy.wait_for_service("/controller_manager/list_controllers", timeout=WALL_TIMEOUT)
+        list_controllers = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
+        wait_for(lambda: controller_states(list_controllers) == {"rover_joint_publisher": "running",
+                                                                  CONTROLLER: "running"},
+                 what="the spawner to start both controllers")
+        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.imu, cls.fix = Latest("/imu/data", Imu), Latest("/navsat/fix", NavSatFix)
+        cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
+        wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
+        # Spawned at z = 0 with the wheels in the ground, as Husky is: wait until it has landed and stopped.
+        wait_for(lambda: cls.at_rest(), what="the rover to come to rest on its wheels")
+
+    @classmethod
+    def tearDownClass(cls):
+        print_figures(cls.figures)
+
+    @classmethod
+    def at_rest(cls):
+        state = cls.get_model_state("rover", "world")
+        speed = math.hypot(state.twist.linear.x, state.twist.linear.y, state.twist.linear.z)
+        return abs(state.pose.position.z - 0.132) < 0.01 and speed < 0.01
+
+    def drive(self, linear, sim_seconds):
+        """Publish the command every 20 ms of wall time for ``sim_seconds`` of sim time (timeout is 0.25 s)."""
+        twist = Twist()
+        twist.linear.x = linear
+        end = rospy.get_time() + sim_seconds
+        while rospy.get_time() < end:
+            self.cmd_vel.publish(twist)
+            rospy.rostime.wallsleep(0.02)
+
+    def test_1_imu_reads_gravity_up_at_rest(self):
+        # Half a second of readings (50 Hz) once the rover has settled after its landing.
+        start = rospy.Time.now() + rospy.Duration(0.2)
+        readings = wait_for(lambda: len(self.imu.since(start)) >= 25 and self.imu.since(start),
+                            what="25 /imu/data messages at rest")
+        mean = [sum(getattr(m.linear_acceleration, axis) for m in readings) / len(readings) for axis in "xyz"]
+        self.figures.append(f"rover hector IMU at rest: mean a = ({mean[0]:.3f}, {mean[1]:.3f}, {mean[2]:.3f}) m/s² "
+                            f"over {len(readings)} messages")
+        self.assertAlmostEqual(mean[2], 9.8, delta=0.05)
+        self.assertLess(math.hypot(mean[0], mean[1]), 0.05)
+        self.assertEqual(readings[-1].header.frame_id, "imu_link")
+
+    def test_2_drives_at_the_commanded_speed_and_the_fix_follows_north(self):
+        wait_for(lambda: self.fix.message, what="/navsat/fix")
+        self.drive(0.5, 1.0)
+        start, pose0, fix0 = rospy.get_time(), self.get_model_state("rover", "world").pose, self.fix.message
+        self.drive(0.5, 3.0)
+        pose1, elapsed, fix1 = self.get_model_state("rover", "world").pose, rospy.get_time() - start, self.fix.message
+        driven = pose1.position.x - pose0.position.x
+        speed = driven / elapsed
+        north = math.radians(fix1.latitude - fix0.latitude) * north_radius()
+        self.figures.append(f"rover (package:// meshes) through ros_control at 0.5 m/s: {speed:.4f} m/s")
+        self.figures.append(f"rover hector GPS: {north:.3f} m north for {driven:.3f} m driven along x")
+        self.assertAlmostEqual(speed, 0.5, delta=0.025)
+        # The fix and the pose are read at slightly different sim times (40 Hz fix): 1 % plus one fix period.
+        self.assertAlmostEqual(north, driven, delta=0.01 * driven + 0.5 / 40)
+        self.assertAlmostEqual(fix1.longitude, fix0.longitude, delta=1e-6)
+
+    def test_3_lidar_publishes_sixteen_rings(self):
+        cloud = rospy.wait_for_message("/velodyne_points", PointCloud2, timeout=WALL_TIMEOUT)
+        fields = [field.name for field in cloud.fields]
+        self.assertEqual(fields, ["x", "y", "z", "intensity", "ring", "time"])
+        rings = {int(point[0]) for point in point_cloud2.read_points(cloud, field_names=("ring",))}
+        self.figures.append(f"rover VLP-16: {cloud.width * cloud.height} points, rings {sorted(rings)}")
+        # In the empty world only the eight rings below the horizon (0 to 7, lowest first) reach the ground.
+        self.assertEqual(rings, set(range(8)))
+        self.assertEqual(cloud.header.frame_id, "velodyne")
+
+    def test_4_holonomic_base_moves_sideways(self):
+        command = rospy.Publisher("/holonomic/cmd_vel", Twist, queue_size=1)
+        odometry = Latest("/holonomic/odom", Odometry)
+        wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the planar move plugin")
+        twist = Twist()
+        twist.linear.y = 0.4
+        start = self.get_model_state("holonomic_base", "world").pose.position
+        end_time = rospy.get_time() + 1.0
+        while rospy.get_time() < end_time:
+            command.publish(twist)
+            rospy.rostime.wallsleep(0.02)
+        end = self.get_model_state("holonomic_base", "world").pose.position
+        reported = odometry.message.twist.twist.linear
+        self.figures.append(f"holonomic base at 0.4 m/s sideways: moved ({end.x - start.x:.3f}, {end.y - start.y:.3f}) "
+                            f"m in 1 s; odometry ({reported.x:.3f}, {reported.y:.3f}) m/s")
+        self.assertAlmostEqual(end.x - start.x, 0.0, delta=0.01)
+        self.assertGreater(end.y - start.y, 0.35)
+        self.assertAlmostEqual(reported.y, 0.4, delta=0.004)  # within 1 %
+        self.assertEqual(odometry.message.header.frame_id, "odom")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_tests", "rover", Rover)
