@@ -13,7 +13,7 @@ from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, NavSatFix, PointCloud2
+from sensor_msgs.msg import Imu, NavSatFix, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
 from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for
@@ -137,6 +137,18 @@ class Rover(unittest.TestCase):
         self.assertGreater(end.y - start.y, 0.35)
         self.assertAlmostEqual(reported.y, 0.4, delta=0.004)  # within 1 %
         self.assertEqual(odometry.message.header.frame_id, "odom")
+
+    def test_5_holonomic_base_sonars(self):
+        front = rospy.wait_for_message("/holonomic/sonar_front", Range, timeout=WALL_TIMEOUT)
+        rear = rospy.wait_for_message("/holonomic/sonar_rear", Range, timeout=WALL_TIMEOUT)
+        self.figures.append(f"holonomic base sonars in the open: front {front.range:.3f} m (fov "
+                            f"{front.field_of_view:.2f}), rear {rear.range:.3f} m (fov {rear.field_of_view:.2f})")
+        self.assertEqual((front.radiation_type, front.max_range), (Range.ULTRASOUND, 3.0))
+        self.assertAlmostEqual(front.field_of_view, 0.26, places=6)
+        self.assertEqual((rear.header.frame_id, rear.max_range), ("sonar_rear_link", 3.0))
+        self.assertAlmostEqual(rear.field_of_view, 0.1, places=6)
+        # Nothing within 3 m (the ground is farther for their lowest rays): both read max_range.
+        self.assertEqual((front.range, rear.range), (3.0, 3.0))
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 """core/imu.py and core/p3d.py on the course's mbot with an IMU board on a fixed joint (lumped, as
 TurtleBot3's imu_link): at rest, turning at 0.5 rad/s, and against the world pose."""
+import logging
+
 import numpy as np
 import pytest
 
@@ -131,14 +133,15 @@ def test_bad_imu_and_p3d_tags_are_refused_with_the_tag(mbot_urdf, tmp_path):
 
 
 def test_an_unknown_sensor_warns_once_and_the_rest_works(mbot_urdf, tmp_path, caplog):
-    sonar = """<gazebo reference="base_link"><sensor type="sonar" name="front_sonar"><update_rate>10</update_rate>
-        <plugin name="sonar" filename="libgazebo_ros_range.so"><topicName>sonar</topicName></plugin></sensor></gazebo>
-        </robot>"""
+    bumper = """<gazebo reference="base_link"><sensor type="contact" name="bumper"><update_rate>10</update_rate>
+        <plugin name="bumper" filename="libgazebo_ros_bumper.so"><bumperTopicName>bumper</bumperTopicName></plugin>
+        </sensor></gazebo></robot>"""
     sim = world_simulation(tmp_path)
     try:
-        spawned = sim.spawn_robot(parse_robot(with_imu(mbot_urdf).replace("</robot>", sonar), "model 'mbot'"), "mbot")
+        spawned = sim.spawn_robot(parse_robot(with_imu(mbot_urdf).replace("</robot>", bumper), "model 'mbot'"), "mbot")
         sim.step(100)
-        warnings = [record.getMessage() for record in caplog.records if "libgazebo_ros_range.so" in record.getMessage()]
+        warnings = [message for message in map(logging.LogRecord.getMessage, caplog.records)
+                    if "libgazebo_ros_bumper.so" in message]
         assert len(warnings) == 1 and "not emulated" in warnings[0]
         assert plugin_of(spawned, ImuSensor).latest is not None and plugin_of(spawned, P3D).latest is not None
     finally:

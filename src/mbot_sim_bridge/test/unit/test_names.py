@@ -23,6 +23,8 @@ EXPECTED = dict([
     ("libhector_gazebo_ros_gps.so", ("/", "/", "r1")),
     ("libgazebo_ros_velodyne_laser.so", ("/", "/", "r1")),
     ("libgazebo_ros_velodyne_gpu_laser.so", ("/", "/", "r1")),
+    ("libgazebo_ros_range.so", ("/", "/", "r1")),
+    ("libhector_gazebo_ros_sonar.so", ("/", "/", "r1")),
 ])
 
 

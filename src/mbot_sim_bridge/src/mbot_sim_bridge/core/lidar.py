@@ -207,9 +207,15 @@ class RaySensor(Plugin):
         self.collision_filter_mask = -1 & ~robot.collision_group
         self.latest: Optional[Scan] = None
 
+    def sensor_world_pose(self) -> Pose:
+        return compose(self.context.robot.link_world_pose(self.config.link), self.config.pose)
+
     def scan(self) -> "Scan":
-        pose = compose(self.context.robot.link_world_pose(self.config.link), self.config.pose)
-        return self.scanner.scan(pose, self.collision_filter_mask)
+        return self.scanner.scan(self.sensor_world_pose(), self.collision_filter_mask)
+
+    def raw_ranges(self) -> np.ndarray:
+        """Every ray's raw range (the laser shape's, before the sensor's masking and noise)."""
+        return self.scanner.cast(self.sensor_world_pose(), self.collision_filter_mask)
 
     def update(self, now: float):
         self.latest = self.scan()
@@ -274,15 +280,9 @@ class LaserScanner:
     def config(self) -> RaySensorConfig:
         return self._config
 
-    def scan(self, sensor_pose_world: Pose, collision_filter_mask: int = -1) -> Scan:
-        """Scan from ``sensor_pose_world`` (link world pose ∘ ``config.pose``).
-
-        A ray sees a collision object only if (object group & collision_filter_mask) != 0 and
-        (object mask & 1) != 0: pybullet 3.2.7's ray test acts as collision group 1
-        (btBroadphaseProxy::DefaultFilter) with this mask. PyBullet puts dynamic bodies in group 1 and
-        mass-0 bodies in group 2, so to hide the robot that carries the sensor, give its links a group bit
-        of their own (not 1 or 2), keep 1 set in their masks, and pass ``-1 & ~robot_bit`` here.
-        """
+    def cast(self, sensor_pose_world: Pose, collision_filter_mask: int = -1) -> np.ndarray:
+        """Each ray's raw range, as Gazebo's laser shape gives it (``GetRange``): range_min plus the hit
+        distance, range_max for a miss; no masking, interpolation or noise. Rays as ``_ray_directions``."""
         config = self._config
         rotation = np.asarray(rotation_matrix(sensor_pose_world.orientation))
         origin = np.asarray(sensor_pose_world.position)
@@ -294,11 +294,22 @@ class LaserScanner:
             hits = self._client.rayTestBatch(points[first:last], points[count + first:count + last],
                                              collisionFilterMask=collision_filter_mask)
             fractions[first:last] = [hit[2] for hit in hits]
-
         # Rays are cast from range_min; a miss (fraction 1) is set to range_max exactly, because
         # min + 1·(max − min) can round to just below max.
-        raw = np.where(fractions >= 1.0, config.range_max,
-                       config.range_min + fractions * (config.range_max - config.range_min))
+        return np.where(fractions >= 1.0, config.range_max,
+                        config.range_min + fractions * (config.range_max - config.range_min))
+
+    def scan(self, sensor_pose_world: Pose, collision_filter_mask: int = -1) -> Scan:
+        """Scan from ``sensor_pose_world`` (link world pose ∘ ``config.pose``).
+
+        A ray sees a collision object only if (object group & collision_filter_mask) != 0 and
+        (object mask & 1) != 0: pybullet 3.2.7's ray test acts as collision group 1
+        (btBroadphaseProxy::DefaultFilter) with this mask. PyBullet puts dynamic bodies in group 1 and
+        mass-0 bodies in group 2, so to hide the robot that carries the sensor, give its links a group bit
+        of their own (not 1 or 2), keep 1 set in their masks, and pass ``-1 & ~robot_bit`` here.
+        """
+        config = self._config
+        raw = self.cast(sensor_pose_world, collision_filter_mask)
         if self._corners is not None:
             r1, r2, r3, r4 = raw[self._corners]
             hb, vb = self._h_weight, self._v_weight

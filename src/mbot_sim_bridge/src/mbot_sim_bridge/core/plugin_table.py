@@ -15,6 +15,7 @@ from .joint_states import JointStatePublisher
 from .lidar import RaySensor
 from .p3d import P3D
 from .planar_move import PlanarMove
+from .range_sensor import HectorSonar, RangeSensor
 from .velodyne_laser import VelodyneLaser
 
 CORE_PLUGINS: Dict[str, type] = {
@@ -32,6 +33,8 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_planar_move.so": PlanarMove,
     "libhector_gazebo_ros_imu.so": HectorImu,
     "libhector_gazebo_ros_gps.so": HectorGps,
+    "libgazebo_ros_range.so": RangeSensor,
+    "libhector_gazebo_ros_sonar.so": HectorSonar,
     "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
     "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,
 }
