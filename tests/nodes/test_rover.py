@@ -3,7 +3,8 @@
 package:// STL and COLLADA files, drives at the commanded speed (ground truth); the hector IMU reads gravity up
 at rest; the hector GPS fix moves north by the distance driven (x is north at referenceHeading 0); the
 VLP-16-style lidar publishes 16 rings. A holonomic base beside it (planar move) moves sideways at the
-commanded speed and its odometry says so."""
+commanded speed and its odometry says so; a skid-steer base (skid steer plugin) drives forward at the
+commanded speed."""
 import math
 import unittest
 
@@ -149,6 +150,24 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(rear.field_of_view, 0.1, places=6)
         # Nothing within 3 m (the ground is farther for their lowest rays): both read max_range.
         self.assertEqual((front.range, rear.range), (3.0, 3.0))
+
+    def test_6_skid_steer_base_drives_forward(self):
+        command = rospy.Publisher("/skid/cmd_vel", Twist, queue_size=1)
+        odometry = Latest("/skid/odom", Odometry)
+        wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the skid steer plugin")
+        twist = Twist()
+        twist.linear.x = 0.5
+        end_time = rospy.get_time() + 1.5
+        while rospy.get_time() < end_time:
+            command.publish(twist)
+            rospy.rostime.wallsleep(0.02)
+        state = self.get_model_state("skid_steer_base", "world")
+        reported = odometry.message.twist.twist.linear.x
+        self.figures.append(f"skid steer base at 0.5 m/s: {state.twist.linear.x:.3f} m/s, odometry {reported:.3f} m/s")
+        self.assertAlmostEqual(state.twist.linear.x, 0.5, delta=0.025)
+        self.assertAlmostEqual(reported, 0.5, delta=0.025)
+        header = odometry.message.header
+        self.assertEqual((header.frame_id, odometry.message.child_frame_id), ("odom", "base_footprint"))
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ from .lidar import RaySensor
 from .p3d import P3D
 from .planar_move import PlanarMove
 from .range_sensor import HectorSonar, RangeSensor
+from .skid_steer_drive import SkidSteerDrive
 from .velodyne_laser import VelodyneLaser
 
 CORE_PLUGINS: Dict[str, type] = {
@@ -31,6 +32,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_imu_sensor.so": ImuSensor,
     "libgazebo_ros_p3d.so": P3D,
     "libgazebo_ros_planar_move.so": PlanarMove,
+    "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
     "libhector_gazebo_ros_imu.so": HectorImu,
     "libhector_gazebo_ros_gps.so": HectorGps,
     "libgazebo_ros_range.so": RangeSensor,

@@ -1,0 +1,45 @@
+"""``libgazebo_ros_skid_steer_drive.so``: cmd_vel in; ground-truth odometry (and, with broadcastTF, the odom TF)
+out."""
+import rospy
+from geometry_msgs.msg import Twist
+
+from ..core.names import resolve_frame, tf_prefix
+from ..core.skid_steer_drive import SkidSteerDrive
+from ..subscriptions import TrackedSubscriber
+from . import RosPlugin, resolve_in_namespace
+from .ground_truth_odometry import OdometryOutput
+
+
+def _covariance(x: float, y: float, yaw_variance: float) -> list:
+    covariance = [0.0] * 36
+    covariance[0::7] = [x, y, 1e12, 1e12, 1e12, yaw_variance]
+    return covariance
+
+
+class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):
+    def __init__(self, context, element, sensor=None):
+        super().__init__(context, element, sensor)
+        params = self.params
+        namespace = self.robot_namespace()
+        prefix = tf_prefix(context.simulation.parameters, namespace)
+        covariance = _covariance(params["covariance_x"], params["covariance_y"], params["covariance_yaw"])
+        self.output = OdometryOutput(self.topics, resolve_in_namespace(namespace, params["odometryTopic"]),
+                                     resolve_frame(params["odometryFrame"], prefix),
+                                     resolve_frame(params["robotBaseFrame"], prefix), covariance,
+                                     params["broadcastTF"], twist_covariance=covariance)
+        self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
+        self.topics.own(TrackedSubscriber(self.command_topic, Twist, self._on_command))
+        rospy.loginfo(f"{self.label}: {self.command_topic} -> wheels {', '.join(self.joints)}, separation "
+                      f"{params['wheelSeparation']:.3f} m, diameter {params['wheelDiameter']:.3f} m, torque "
+                      f"{params['torque']:.1f} N·m; odometry on {self.output.odom_publisher.resolved_name} at "
+                      f"{params['updateRate']:g} Hz")
+
+    def _on_command(self, message: Twist):
+        linear, angular = message.linear.x, message.angular.z
+        if not self.set_command(linear, angular):
+            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a non-finite value "
+                                        f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
+
+    def update(self, now: float):
+        super().update(now)
+        self.output.publish(now, *self.latest)
