@@ -25,6 +25,7 @@ EXPECTED = dict([
     ("libgazebo_ros_velodyne_laser.so", ("/", "/", "r1")),
     ("libgazebo_ros_velodyne_gpu_laser.so", ("/", "/", "r1")),
     ("libgazebo_ros_range.so", ("/", "/", "r1")),
+    ("libgazebo_ros_bumper.so", ("/", "/", "r1")),
     ("libhector_gazebo_ros_sonar.so", ("/", "/", "r1")),
 ])
 

@@ -190,6 +190,8 @@ class Engine:
         self.steps = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
+        # PyBullet body -> link index -> Gazebo's "model::link::collision" of the collision it holds.
+        self.collision_names: Dict[int, Dict[int, str]] = {}
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
@@ -214,6 +216,7 @@ class Engine:
         self.steps = 0
         self.robots.clear()
         self.world_bodies.clear()
+        self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
 
@@ -231,6 +234,11 @@ class Engine:
         """Register the bodies a world loader built, so reset and model queries know them."""
         for name, body in world.bodies.items():
             self.world_bodies[name] = body
+            shapes = [shape for shape in world.shapes if shape.model == name]
+            # One static collision is the body's base; otherwise each collision is a child link, in order.
+            links = [-1] if self.client.getNumJoints(body) == 0 else range(len(shapes))
+            self.collision_names[body] = {link: f"{name}::{shape.link}::{shape.name}"
+                                          for link, shape in zip(links, shapes)}
             self._root_from_com[body] = inverse(world.inertial_frames[name])
             self._remember_initial_state(body)
 
@@ -265,6 +273,10 @@ class Engine:
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
         self.robots[robot.name] = robot
+        # A link holding several collisions is named by its first: Bullet reports contacts per link.
+        self.collision_names[robot.body] = {robot.link_index[link]: f"{robot.name}::{link}::{names[0]}"
+                                            for link, names in robot.model.collision_names().items()
+                                            if names and link in robot.link_index}
         self._root_from_com[robot.body] = robot.root_from_com
         self._remember_initial_state(robot.body)
 
@@ -277,6 +289,7 @@ class Engine:
             raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
+        self.collision_names.pop(body, None)
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:

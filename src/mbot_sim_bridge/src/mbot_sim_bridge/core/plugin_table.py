@@ -5,6 +5,7 @@ the benchmarks and the tests build their Simulations from it; adding a plugin ad
 """
 from typing import Dict
 
+from .bumper import Bumper
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
 from .gazebo_ros_control import GazeboRosControlPlugin
@@ -36,6 +37,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libhector_gazebo_ros_imu.so": HectorImu,
     "libhector_gazebo_ros_gps.so": HectorGps,
     "libgazebo_ros_range.so": RangeSensor,
+    "libgazebo_ros_bumper.so": Bumper,
     "libhector_gazebo_ros_sonar.so": HectorSonar,
     "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
     "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,

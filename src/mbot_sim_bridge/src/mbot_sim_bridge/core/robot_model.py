@@ -105,6 +105,27 @@ class RobotModel:
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
 
+    def collision_names(self) -> Dict[str, List[str]]:
+        """Simulated link -> the names sdformat gives the collisions it holds: "L_collision" (then
+        "L_collision_1", ...) for link L's own, "P_fixed_joint_lump__L_collision" for those lumped into P."""
+        return {holder: [name for name, _, _ in boxes] for holder, boxes in self.collision_boxes().items()}
+
+    def collision_boxes(self) -> Dict[str, List[Tuple[str, Pose, Tuple[float, float, float]]]]:
+        """Simulated link -> (sdformat's name, pose in that link's frame, half extents) of each collision it
+        holds; a mesh's extents are unknown here and taken as zero (its origin stands for it)."""
+        boxes: Dict[str, List[Tuple[str, Pose, Tuple[float, float, float]]]] = {}
+        elements = {element.get("name"): element for element in self.document.root.findall("link")}
+        for link in self.links.values():
+            if link.name not in self.lumped_into or link.name not in elements:
+                continue
+            holder, offset = self.lumped_into[link.name]
+            prefix = link.name if holder == link.name else f"{holder}_fixed_joint_lump__{link.name}"
+            for index, collision in enumerate(elements[link.name].findall("collision")):
+                name = f"{prefix}_collision" + (f"_{index}" if index else "")
+                pose = compose(offset, read_origin(collision, self.document))
+                boxes.setdefault(holder, []).append((name, pose, _half_extents(collision.find("geometry"))))
+        return boxes
+
     def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
         """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
         return [(link.name, sensor) for link in self.links.values()
@@ -431,3 +452,16 @@ def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], documen
         ElementTree.SubElement(inertial, "inertia", ixx=repr(_NEGLIGIBLE_INERTIA), iyy=repr(_NEGLIGIBLE_INERTIA),
                                izz=repr(_NEGLIGIBLE_INERTIA), ixy="0", ixz="0", iyz="0")
     return ElementTree.tostring(root, encoding="unicode")
+
+
+def _half_extents(geometry: Optional[ElementTree.Element]) -> Tuple[float, float, float]:
+    """Half the size of a checked URDF shape along its own axes (a mesh: zero, its size is not read here)."""
+    shape = geometry[0] if geometry is not None and len(geometry) else None
+    if shape is None or shape.tag == "mesh":
+        return (0.0, 0.0, 0.0)
+    if shape.tag == "box":
+        return tuple(value / 2.0 for value in parse_floats(shape.get("size", "0 0 0"), 3))
+    radius = float(shape.get("radius", "0"))
+    if shape.tag == "cylinder":
+        return (radius, radius, float(shape.get("length", "0")) / 2.0)
+    return (radius, radius, radius)
