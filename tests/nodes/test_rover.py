@@ -72,13 +72,14 @@ class Rover(unittest.TestCase):
         speed = math.hypot(state.twist.linear.x, state.twist.linear.y, state.twist.linear.z)
         return abs(state.pose.position.z - 0.132) < 0.01 and speed < 0.01
 
-    def drive(self, linear, sim_seconds):
-        """Publish the command every 20 ms of wall time for ``sim_seconds`` of sim time (timeout is 0.25 s)."""
+    def drive(self, linear, sim_seconds, publisher=None, lateral=0.0):
+        """Publish the command every 20 ms of wall time for ``sim_seconds`` of sim time (the rover's timeout is
+        0.25 s), on the rover's cmd_vel or on ``publisher``."""
         twist = Twist()
-        twist.linear.x = linear
+        twist.linear.x, twist.linear.y = linear, lateral
         end = rospy.get_time() + sim_seconds
         while rospy.get_time() < end:
-            self.cmd_vel.publish(twist)
+            (publisher or self.cmd_vel).publish(twist)
             rospy.rostime.wallsleep(0.02)
 
     def test_1_imu_reads_gravity_up_at_rest(self):
@@ -123,13 +124,8 @@ class Rover(unittest.TestCase):
         command = rospy.Publisher("/holonomic/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/holonomic/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the planar move plugin")
-        twist = Twist()
-        twist.linear.y = 0.4
         start = self.get_model_state("holonomic_base", "world").pose.position
-        end_time = rospy.get_time() + 1.0
-        while rospy.get_time() < end_time:
-            command.publish(twist)
-            rospy.rostime.wallsleep(0.02)
+        self.drive(0.0, 1.0, command, lateral=0.4)
         end = self.get_model_state("holonomic_base", "world").pose.position
         reported = odometry.message.twist.twist.linear
         self.figures.append(f"holonomic base at 0.4 m/s sideways: moved ({end.x - start.x:.3f}, {end.y - start.y:.3f}) "
@@ -155,12 +151,7 @@ class Rover(unittest.TestCase):
         command = rospy.Publisher("/skid/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/skid/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the skid steer plugin")
-        twist = Twist()
-        twist.linear.x = 0.5
-        end_time = rospy.get_time() + 1.5
-        while rospy.get_time() < end_time:
-            command.publish(twist)
-            rospy.rostime.wallsleep(0.02)
+        self.drive(0.5, 1.5, command)
         state = self.get_model_state("skid_steer_base", "world")
         reported = odometry.message.twist.twist.linear.x
         self.figures.append(f"skid steer base at 0.5 m/s: {state.twist.linear.x:.3f} m/s, odometry {reported:.3f} m/s")

@@ -137,7 +137,33 @@ _LOG_LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WAR
                "fatal": logging.CRITICAL}
 
 
-class DiffDrive(Plugin):
+class TwistCommand:
+    """The last valid cmd_vel (linear.x, angular.z) of a drive, stored from ROS threads, read by the loop; mixed
+    in before Plugin."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._lock = threading.Lock()
+        self._command = (0.0, 0.0)
+
+    def set_command(self, linear: float, angular: float) -> bool:
+        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return False
+        with self._lock:
+            self._command = (linear, angular)
+        return True
+
+    def command(self) -> Tuple[float, float]:
+        with self._lock:
+            return self._command
+
+    def stop(self):
+        with self._lock:
+            self._command = (0.0, 0.0)
+
+
+class DiffDrive(TwistCommand, Plugin):
     """The plugin's physics: wheel motors from the last command, every ``updateRate``; odometry on demand."""
     NAMESPACE_RULE = names.MODEL
 
@@ -172,24 +198,13 @@ class DiffDrive(Plugin):
         self.needs_every_step = self.encoder is not None
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
         self.last_update = context.simulation.sim_time
-        self._lock = threading.Lock()  # commands arrive from other threads
-        self._command = (0.0, 0.0)
-
-    def set_command(self, linear: float, angular: float) -> bool:
-        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            return False
-        with self._lock:
-            self._command = (linear, angular)
-        return True
 
     def on_step(self, step_size: float):
         (_, left_rate, _), (_, right_rate, _) = self.context.robot.joint_state(self.joints)
         self.encoder.integrate(left_rate, right_rate, step_size)
 
     def update(self, now: float):
-        with self._lock:
-            linear, angular = self._command
+        linear, angular = self.command()
         robot = self.context.robot
         targets = self.geometry.wheel_rim_speeds(linear, angular)
         radius = self.geometry.wheel_radius
@@ -216,5 +231,4 @@ class DiffDrive(Plugin):
         self.ramp.reset()
         if self.encoder is not None:
             self.encoder.reset()
-        with self._lock:
-            self._command = (0.0, 0.0)
+        self.stop()

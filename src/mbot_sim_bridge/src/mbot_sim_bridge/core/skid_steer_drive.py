@@ -7,13 +7,11 @@ four wheels get velocity motors of at most ``torque``: right wheels v + ω·s/2,
 the wheel radius. ``broadcastTF`` (default false) adds the odom -> base TF. The last cmd_vel holds until
 another comes or a reset; a NaN or infinite one is ignored.
 """
-import math
-import threading
 from typing import NamedTuple, Optional, Tuple
 
 from . import names
 from .clock import UpdateTimer
-from .diff_drive import yaw_rotated_velocity
+from .diff_drive import TwistCommand, yaw_rotated_velocity
 from .errors import ConfigError
 from .geometry import Pose, yaw
 from .params import Param, non_negative, positive
@@ -28,7 +26,7 @@ class SkidSteerOdometry(NamedTuple):
     angular: float
 
 
-class SkidSteerDrive(Plugin):
+class SkidSteerDrive(TwistCommand, Plugin):
     """Core of libgazebo_ros_skid_steer_drive.so (GazeboRosSkidSteerDrive)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "GazeboRosSkidSteerDrive Plugin"
@@ -64,25 +62,14 @@ class SkidSteerDrive(Plugin):
         self.joints = tuple(params[tag] for tag in WHEEL_TAGS)
         self.driven_joints = self.joints
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
-        self._lock = threading.Lock()  # commands arrive from other threads
-        self._command = (0.0, 0.0)
         self.latest: Optional[SkidSteerOdometry] = None
-
-    def set_command(self, linear: float, angular: float) -> bool:
-        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            return False
-        with self._lock:
-            self._command = (linear, angular)
-        return True
 
     def update(self, now: float):
         robot = self.context.robot
         pose = robot.root_pose()
         linear, angular = robot.root_velocity()
         self.latest = SkidSteerOdometry(pose, yaw_rotated_velocity(linear, yaw(pose.orientation)), angular[2])
-        with self._lock:
-            speed, turn = self._command
+        speed, turn = self.command()
         half_track = turn * self.params["wheelSeparation"] / 2.0
         radius = self.params["wheelDiameter"] / 2.0
         left, right = speed - half_track, speed + half_track
@@ -91,5 +78,4 @@ class SkidSteerDrive(Plugin):
 
     def reset(self, now: float):
         super().reset(now)
-        with self._lock:
-            self._command = (0.0, 0.0)
+        self.stop()

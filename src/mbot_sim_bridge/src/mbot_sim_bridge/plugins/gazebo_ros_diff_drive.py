@@ -12,6 +12,14 @@ from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import set_pose, set_quaternion, set_xyz
 
 
+def on_twist(plugin, message: Twist):
+    """cmd_vel to a TwistCommand drive; a non-finite one is refused with a throttled warning."""
+    linear, angular = message.linear.x, message.angular.z
+    if not plugin.set_command(linear, angular):
+        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a non-finite value "
+                                    f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
+
+
 class GazeboRosDiffDrive(RosPlugin, DiffDrive):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
@@ -42,10 +50,7 @@ class GazeboRosDiffDrive(RosPlugin, DiffDrive):
                       f"{self.geometry.legacy_mode}")
 
     def _on_command(self, message: Twist):
-        linear, angular = message.linear.x, message.angular.z
-        if not self.set_command(linear, angular):
-            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a non-finite value "
-                                        f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
+        on_twist(self, message)
 
     def update(self, now: float):
         # Topics nobody listens to are skipped: the loop publishes synchronously, so each costs real time.

@@ -7,6 +7,7 @@ from ..core.names import resolve_frame, tf_prefix
 from ..core.skid_steer_drive import SkidSteerDrive
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
+from .gazebo_ros_diff_drive import on_twist
 from .ground_truth_odometry import OdometryOutput
 
 
@@ -28,17 +29,11 @@ class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):
                                      resolve_frame(params["robotBaseFrame"], prefix), covariance,
                                      params["broadcastTF"], twist_covariance=covariance)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
-        self.topics.own(TrackedSubscriber(self.command_topic, Twist, self._on_command))
+        self.topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
         rospy.loginfo(f"{self.label}: {self.command_topic} -> wheels {', '.join(self.joints)}, separation "
                       f"{params['wheelSeparation']:.3f} m, diameter {params['wheelDiameter']:.3f} m, torque "
                       f"{params['torque']:.1f} N·m; odometry on {self.output.odom_publisher.resolved_name} at "
                       f"{params['updateRate']:g} Hz")
-
-    def _on_command(self, message: Twist):
-        linear, angular = message.linear.x, message.angular.z
-        if not self.set_command(linear, angular):
-            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a non-finite value "
-                                        f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
 
     def update(self, now: float):
         super().update(now)
