@@ -1,5 +1,6 @@
-"""hector_gazebo_plugins' IMU and GPS (core/hector_imu.py, core/hector_gps.py): gravity up at rest, the turn
-rate, the fix moving north or east by the distance travelled as upstream converts it, the sensor model."""
+"""hector_gazebo_plugins' IMU, GPS and magnetometer (core/hector_imu.py, hector_gps.py, hector_magnetic.py):
+gravity up at rest, the turn rate, the fix moving north or east by the distance travelled as upstream converts
+it, the field turning with the body, the sensor model."""
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy
 from mbot_sim_bridge.core.hector_gps import HectorGps, earth_radii
 from mbot_sim_bridge.core.hector_imu import HectorImu
+from mbot_sim_bridge.core.hector_magnetic import HectorMagnetic
 from mbot_sim_bridge.core.hector_sensor_model import SensorModel
 from mbot_sim_bridge.core.robot_model import parse_robot
 
@@ -27,6 +29,13 @@ BOX = """<robot name="box">
     </plugin>
   </gazebo>
   <gazebo>
+    <plugin name="magnetometer" filename="libhector_gazebo_ros_magnetic.so">
+      <updateRate>50</updateRate><bodyName>base_link</bodyName><topicName>magnetic</topicName>
+      <magnitude>0.5</magnitude><declination>10</declination><inclination>60</inclination>
+      <referenceHeading>{heading}</referenceHeading>
+    </plugin>
+  </gazebo>
+  <gazebo>
     <plugin name="gps_controller" filename="libhector_gazebo_ros_gps.so">
       <updateRate>40</updateRate><bodyName>base_link</bodyName><frameId>base_link</frameId>
       <referenceLatitude>49.9</referenceLatitude><referenceLongitude>8.9</referenceLongitude>
@@ -41,9 +50,14 @@ NOISY_IMU = """
       <yawDrift>0.005</yawDrift><yawGaussianNoise>0.005</yawGaussianNoise>"""
 
 
-def simulate(tmp_path, heading=0.0, imu="", gps="", pose=Pose((0.0, 0.0, 0.1), (0.0, 0.0, 0.0, 1.0)), seed=0):
+def spawn_box(tmp_path, heading=0.0, imu="", gps="", pose=Pose((0.0, 0.0, 0.1), (0.0, 0.0, 0.0, 1.0)), seed=0):
     sim = world_simulation(tmp_path, seed=seed)
     spawned = sim.spawn_robot(parse_robot(BOX.format(heading=heading, imu=imu, gps=gps), "model 'box'"), "box", pose)
+    return sim, spawned
+
+
+def simulate(tmp_path, **options):
+    sim, spawned = spawn_box(tmp_path, **options)
     return sim, plugin_of(spawned, HectorImu), plugin_of(spawned, HectorGps)
 
 
@@ -143,3 +157,22 @@ def test_rpy_offset_rotates_the_orientation_and_the_rates(tmp_path):
     assert yaw == pytest.approx(math.pi / 2, abs=0.01)
     # A roll rate in the body frame is seen along -y by the IMU rotated 90 degrees about z.
     assert reading.angular_velocity == pytest.approx((0.0, -0.5, 0.0), abs=2e-3)
+
+
+@pytest.mark.parametrize("yaw", [0.0, math.pi / 2])
+def test_the_magnetic_field_turns_with_the_body_as_upstream_sets_it(tmp_path, yaw):
+    """World field (m·cos ι·cos(ψ − δ), m·cos ι·sin(ψ − δ), −m·sin ι) with ψ = 0, δ = 10°, ι = 60°, m = 0.5,
+    read in the body frame."""
+    pose = pose_from_xyz_rpy((0.0, 0.0, 0.1), (0.0, 0.0, yaw))
+    sim, spawned = spawn_box(tmp_path, pose=pose)
+    magnetometer = plugin_of(spawned, HectorMagnetic)
+    sim.step(20)
+    magnetometer.update(sim.sim_time)
+    horizontal = 0.5 * math.cos(math.radians(60))
+    world = (horizontal * math.cos(math.radians(-10)), horizontal * math.sin(math.radians(-10)),
+             -0.5 * math.sin(math.radians(60)))
+    expected = (math.cos(yaw) * world[0] + math.sin(yaw) * world[1],
+                -math.sin(yaw) * world[0] + math.cos(yaw) * world[1], world[2])
+    field = tuple(round(value, 4) for value in magnetometer.latest.field)
+    print(f"figure: hector magnetometer at yaw {math.degrees(yaw):.0f} deg: {field}")
+    assert magnetometer.latest.field == pytest.approx(expected, abs=1e-3)

@@ -22,6 +22,7 @@ EXPECTED = dict([
     # hector_gazebo_plugins (melodic-devel) and velodyne_simulator (1.0.13): NodeHandle(tag or "" / "/").
     ("libhector_gazebo_ros_imu.so", ("/", "/", "r1")),
     ("libhector_gazebo_ros_gps.so", ("/", "/", "r1")),
+    ("libhector_gazebo_ros_magnetic.so", ("/", "/", "r1")),
     ("libgazebo_ros_velodyne_laser.so", ("/", "/", "r1")),
     ("libgazebo_ros_velodyne_gpu_laser.so", ("/", "/", "r1")),
     ("libgazebo_ros_range.so", ("/", "/", "r1")),

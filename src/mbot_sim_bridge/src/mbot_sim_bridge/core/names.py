@@ -10,8 +10,8 @@ rule       absent                        empty                  plugins
 MODEL      the model name                the model name         diff_drive, joint_state_publisher, ros_control
 SENSOR     the simulator's ("/")         the model name         laser, camera, openni_kinect
 ROOT       "/"                           "/"                    imu (the model plugin), p3d, planar_move, skid_steer,
-                                                                range, bumper, hector imu, gps and
-                                                                sonar, velodyne
+                                                                range, bumper, hector imu, gps,
+                                                                magnetic and sonar, velodyne
 IMU_SENSOR "/" + the model name          "/"                    imu_sensor
 ========== ============================= ====================== ==============================================
 """

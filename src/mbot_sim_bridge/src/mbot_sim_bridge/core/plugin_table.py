@@ -11,6 +11,7 @@ from .diff_drive import DiffDrive
 from .gazebo_ros_control import GazeboRosControlPlugin
 from .hector_gps import HectorGps
 from .hector_imu import HectorImu
+from .hector_magnetic import HectorMagnetic
 from .imu import ImuModelPlugin, ImuSensor
 from .joint_states import JointStatePublisher
 from .lidar import RaySensor
@@ -36,6 +37,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
     "libhector_gazebo_ros_imu.so": HectorImu,
     "libhector_gazebo_ros_gps.so": HectorGps,
+    "libhector_gazebo_ros_magnetic.so": HectorMagnetic,
     "libgazebo_ros_range.so": RangeSensor,
     "libgazebo_ros_bumper.so": Bumper,
     "libhector_gazebo_ros_sonar.so": HectorSonar,
