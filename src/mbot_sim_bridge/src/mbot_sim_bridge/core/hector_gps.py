@@ -19,13 +19,10 @@ from typing import NamedTuple, Optional, Tuple
 
 
 from . import names
-from .hector_imu import HECTOR_UPDATE_PARAMS, body_link, update_timer
+from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from .log import get_logger, warn_once
 from .params import Param, non_negative
 from .plugin import Plugin
-
-_logger = get_logger(__name__)
 
 EQUATORIAL_RADIUS = 6378137.0
 FLATTENING = 1.0 / 298.257223563
@@ -49,7 +46,7 @@ def earth_radii(latitude_degrees: float) -> Tuple[float, float]:
     return prime_vertical * (1 - EXCENTRICITY2) * temp, prime_vertical * math.cos(math.radians(latitude_degrees))
 
 
-class HectorGps(Plugin):
+class HectorGps(HectorUpdates, Plugin):
     """Core of libhector_gazebo_ros_gps.so (hector's GazeboRosGps)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "GazeboRosGps"
@@ -80,9 +77,7 @@ class HectorGps(Plugin):
         super().__init__(context, element, sensor)
         self.params = params = self.read_params()
         where = f"{context.where(element)}: {self.label}"
-        if params["useWorldSphericalCoordinates"]:
-            warn_once(_logger, f"{where}: <useWorldSphericalCoordinates> true is not emulated (the world's "
-                               "<spherical_coordinates> are not read); the reference tags apply")
+        warn_world_coordinates(params, where, "the reference tags")
         self.link = body_link(context, element, self.label, params["bodyName"])
         self.frame_id = params["frameId"]
         self.heading = math.radians(params["referenceHeading"])
@@ -90,15 +85,9 @@ class HectorGps(Plugin):
         rng = context.random_stream(element.get("name") or "hector_gps")
         self.position_model = SensorModel.from_params(params, "", 3, rng, where)
         self.velocity_model = SensorModel.from_params(params, "velocity", 3, rng, where)
+        self.sensor_models = (self.position_model, self.velocity_model)
         self.timer = update_timer(params, context.simulation.sim_time)
-        self.last_update: Optional[float] = None
         self.latest: Optional[GpsReading] = None
-
-    def reset(self, now: float):
-        super().reset(now)
-        self.last_update = None
-        self.position_model.reset()
-        self.velocity_model.reset()
 
     def geodetic(self, position) -> Tuple[float, float, float]:
         """(latitude, longitude, altitude) of a world position, as upstream converts it."""
@@ -109,8 +98,7 @@ class HectorGps(Plugin):
                 self.params["referenceAltitude"] + z)
 
     def update(self, now: float):
-        dt = now - self.last_update if self.last_update is not None else 0.0
-        self.last_update = now
+        dt = self.elapsed(now)
         robot = self.context.robot
         velocity = self.velocity_model(robot.link_world_velocity(self.link)[0], dt)
         position = self.position_model(robot.link_world_pose(self.link).position, dt)

@@ -27,8 +27,11 @@ from .errors import ConfigError
 from .geometry import IDENTITY, Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
 from .hector_sensor_model import SensorModel, sensor_model_params
 from .imu import gazebo_body, read_vector_param
+from .log import get_logger, warn_once
 from .params import Param, non_negative
 from .plugin import Plugin
+
+_logger = get_logger(__name__)
 
 Quaternion = Tuple[float, float, float, float]
 Vector = Tuple[float, float, float]
@@ -61,6 +64,35 @@ def update_timer(params, now: float) -> UpdateTimer:
     return timer
 
 
+class HectorUpdates:
+    """What hector's plugins share, mixed in before the Plugin class: ``elapsed`` gives the sim time since the
+    last update (0 on the first after load or reset, as ``getTimeSinceLastUpdate``), and a reset redraws the
+    drifts of the plugin's ``sensor_models``."""
+    sensor_models: Tuple[SensorModel, ...] = ()
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.last_update: Optional[float] = None
+
+    def elapsed(self, now: float) -> float:
+        dt = now - self.last_update if self.last_update is not None else 0.0
+        self.last_update = now
+        return dt
+
+    def reset(self, now: float):
+        super().reset(now)
+        self.last_update = None
+        for model in self.sensor_models:
+            model.reset()
+
+
+def warn_world_coordinates(params, where: str, what: str):
+    """``useWorldSphericalCoordinates`` true: the world's <spherical_coordinates> are not read here."""
+    if params["useWorldSphericalCoordinates"]:
+        warn_once(_logger, f"{where}: <useWorldSphericalCoordinates> true is not emulated (the world's "
+                           f"<spherical_coordinates> are not read); {what} apply")
+
+
 def body_link(context, element, label: str, body: Optional[str]) -> str:
     """The link a hector plugin measures: ``bodyName`` (a lumped one becomes the link that survives, as
     sdformat renames it), else the model's root link as ``Model::GetLink()`` gives it."""
@@ -83,7 +115,7 @@ def _rotate_back(orientation: Quaternion, vector) -> np.ndarray:
     return np.asarray(rotation_matrix(orientation)).T @ np.asarray(vector, dtype=float)
 
 
-class HectorImu(Plugin):
+class HectorImu(HectorUpdates, Plugin):
     """Core of libhector_gazebo_ros_imu.so (hector's GazeboRosIMU)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "GazeboRosIMU"
@@ -126,21 +158,19 @@ class HectorImu(Plugin):
         self.timer = update_timer(params, context.simulation.sim_time)
         self.latest: Optional[HectorImuReading] = None
         self.calibration_pending = False
-        self._restart(context.simulation.sim_time)
+        self.sensor_models = (self.accel_model, self.rate_model, self.yaw_model)
+        self._rest()
 
-    def _restart(self, now: float):
-        """GazeboRosIMU::Reset: orientation identity, velocity and acceleration zero, fresh drifts."""
-        self.last_update: Optional[float] = None
+    def _rest(self):
+        """GazeboRosIMU::Reset's motion state: orientation identity, velocity and acceleration zero."""
         self.orientation: Quaternion = IDENTITY.orientation
         self.velocity = np.zeros(3)
         self.accel = np.zeros(3)
         self.rate = np.zeros(3)
-        for model in (self.accel_model, self.rate_model, self.yaw_model):
-            model.reset()
 
     def reset(self, now: float):
-        super().reset(now)
-        self._restart(now)
+        super().reset(now)  # fresh drifts
+        self._rest()
 
     def calibrate(self):
         """The calibrate service (from another thread): the next update starts with the rate drift at zero."""
@@ -150,8 +180,7 @@ class HectorImu(Plugin):
         if self.calibration_pending:
             self.calibration_pending = False
             self.rate_model.reset(np.zeros(3))
-        dt = now - self.last_update if self.last_update is not None else 0.0
-        self.last_update = now
+        dt = self.elapsed(now)
         robot = self.context.robot
         pose = robot.link_world_pose(self.link)
         rot = compose(Pose((0.0, 0.0, 0.0), self.offset), Pose((0.0, 0.0, 0.0), pose.orientation)).orientation

@@ -16,13 +16,10 @@ import numpy as np
 
 from . import names
 from .geometry import rotation_matrix
-from .hector_imu import HECTOR_UPDATE_PARAMS, body_link, update_timer
+from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from .log import get_logger, warn_once
 from .params import Param, non_negative
 from .plugin import Plugin
-
-_logger = get_logger(__name__)
 
 
 class MagneticReading(NamedTuple):
@@ -30,7 +27,7 @@ class MagneticReading(NamedTuple):
     field: Tuple[float, float, float]
 
 
-class HectorMagnetic(Plugin):
+class HectorMagnetic(HectorUpdates, Plugin):
     """Core of libhector_gazebo_ros_magnetic.so (hector's GazeboRosMagnetic)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "GazeboRosMagnetic"
@@ -57,9 +54,7 @@ class HectorMagnetic(Plugin):
         super().__init__(context, element, sensor)
         self.params = params = self.read_params()
         where = f"{context.where(element)}: {self.label}"
-        if params["useWorldSphericalCoordinates"]:
-            warn_once(_logger, f"{where}: <useWorldSphericalCoordinates> true is not emulated (the world's "
-                               "<spherical_coordinates> are not read); referenceHeading applies")
+        warn_world_coordinates(params, where, "referenceHeading")
         self.link = body_link(context, element, self.label, params["bodyName"])
         self.frame_id = params["frameId"] if params["frameId"] is not None else (params["bodyName"] or self.link)
         heading, declination, inclination = (math.radians(params[tag]) for tag in
@@ -70,18 +65,12 @@ class HectorMagnetic(Plugin):
                                      -magnitude * math.sin(inclination)])
         self.model = SensorModel.from_params(params, "", 3, context.random_stream(element.get("name") or "magnetic"),
                                              where)
+        self.sensor_models = (self.model,)
         self.timer = update_timer(params, context.simulation.sim_time)
-        self.last_update: Optional[float] = None
         self.latest: Optional[MagneticReading] = None
 
-    def reset(self, now: float):
-        super().reset(now)
-        self.last_update = None
-        self.model.reset()
-
     def update(self, now: float):
-        dt = now - self.last_update if self.last_update is not None else 0.0
-        self.last_update = now
+        dt = self.elapsed(now)
         orientation = self.context.robot.link_world_pose(self.link).orientation
         body_field = np.asarray(rotation_matrix(orientation)).T @ self.world_field
         self.latest = MagneticReading(now, tuple(float(value) for value in self.model(body_field, dt)))

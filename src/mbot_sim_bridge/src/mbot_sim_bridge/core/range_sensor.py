@@ -15,7 +15,7 @@ from typing import NamedTuple, Optional
 
 from . import names
 from .clock import UpdateTimer
-from .hector_imu import HECTOR_UPDATE_PARAMS, update_timer
+from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, update_timer
 from .hector_sensor_model import SensorModel, sensor_model_params
 from .lidar import RaySensor
 from .params import Param, non_negative
@@ -61,7 +61,7 @@ class RangeSensor(RaySensor):
         self.latest = RangeReading(now, reading)
 
 
-class HectorSonar(RaySensor):
+class HectorSonar(HectorUpdates, RaySensor):
     """Core of libhector_gazebo_ros_sonar.so (hector's GazeboRosSonar)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "GazeboRosSonar"
@@ -83,18 +83,12 @@ class HectorSonar(RaySensor):
         where = f"{context.where(element)}: {self.label}"
         self.model = SensorModel.from_params(self.params, "", 1, context.random_stream(f"{config.sensor_name}/sonar"),
                                              where)
+        self.sensor_models = (self.model,)
         self.timer = update_timer(self.params, context.simulation.sim_time)
-        self.last_update: Optional[float] = None
         self.latest: Optional[RangeReading] = None
 
-    def reset(self, now: float):
-        super().reset(now)
-        self.last_update = None
-        self.model.reset()
-
     def update(self, now: float):
-        dt = now - self.last_update if self.last_update is not None else 0.0
-        self.last_update = now
+        dt = self.elapsed(now)
         config = self.config
         reading = float(self.raw_ranges().min())
         if reading < config.range_max:
