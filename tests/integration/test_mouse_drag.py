@@ -25,7 +25,10 @@ from xvfb import Xvfb
 
 WORLDS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "worlds")
 DRAG_TO = (1.5, 1.0)  # where the mouse lets the box go, in world x, y
-WALL_SECONDS = 8.0  # the simulation steps this long while the mouse works
+WALL_SECONDS = 8.0  # the simulation steps at least this long while the mouse works
+# With the button still down at the end of a drag, the box gets this many steps to catch up with the mouse: counted
+# in steps, not wall time, because a loaded machine steps the simulation far fewer times a second.
+HOLD_STEPS = 2000
 
 
 def insert(simulation, tmp_path, database_name, name, x, y):
@@ -36,11 +39,17 @@ def insert(simulation, tmp_path, database_name, name, x, y):
 
 
 def window_pixel(client, point):
-    """Where a world point appears in the window, from its camera's view and projection matrices."""
-    camera = client.getDebugVisualizerCamera()
-    width, height = camera[0], camera[1]
-    view, projection = np.array(camera[2]).reshape(4, 4).T, np.array(camera[3]).reshape(4, 4).T
-    clip = projection @ view @ np.array([point[0], point[1], point[2], 1.0])
+    """Where a world point appears in the window, from its camera's view and projection matrices (read again until
+    the window has applied the camera: before that they are zero)."""
+    deadline = time.monotonic() + 30.0
+    while True:
+        camera = client.getDebugVisualizerCamera()
+        width, height = camera[0], camera[1]
+        view, projection = np.array(camera[2]).reshape(4, 4).T, np.array(camera[3]).reshape(4, 4).T
+        clip = projection @ view @ np.array([point[0], point[1], point[2], 1.0])
+        if abs(clip[3]) > 1e-9 or time.monotonic() > deadline:
+            break
+        time.sleep(0.05)
     x, y = clip[:2] / clip[3]
     return int(round((x + 1.0) / 2.0 * width)), int(round((1.0 - y) / 2.0 * height))
 
@@ -49,7 +58,9 @@ def xdotool(display, *arguments):
     subprocess.run(["xdotool", *arguments], env=dict(os.environ, DISPLAY=display), check=True, timeout=10)
 
 
-def drag(display, start, end):
+def drag(display, start, end, steps):
+    """Press on ``start``, move to ``end``, and let go once the simulation has stepped HOLD_STEPS more
+    (``steps()`` counts them) or a minute has passed."""
     xdotool(display, "mousemove", *map(str, start))
     time.sleep(0.3)
     xdotool(display, "mousedown", "1")
@@ -57,7 +68,9 @@ def drag(display, start, end):
     for step in range(1, 31):
         xdotool(display, "mousemove", *(str(a + (b - a) * step // 30) for a, b in zip(start, end)))
         time.sleep(0.05)
-    time.sleep(1.0)
+    held_from, deadline = steps(), time.monotonic() + 60.0
+    while steps() - held_from < HOLD_STEPS and time.monotonic() < deadline:
+        time.sleep(0.05)
     xdotool(display, "mouseup", "1")
 
 
@@ -92,7 +105,7 @@ def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulati
 
     def mouse_work():
         for start, end in drags:
-            drag(server.display, start, end)
+            drag(server.display, start, end, lambda: simulation.engine.steps)
     mouse = threading.Thread(target=mouse_work)
     mouse.start()
     started = time.monotonic()
