@@ -28,7 +28,7 @@ from .geometry import IDENTITY, Pose, compose, inverse, pose_from_xyz_rpy, rotat
 from .hector_sensor_model import SensorModel, sensor_model_params
 from .imu import gazebo_body, read_vector_param
 from .log import get_logger, warn_once
-from .params import Param, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, non_negative
 from .plugin import Plugin
 
 _logger = get_logger(__name__)
@@ -129,7 +129,7 @@ class HectorImu(HectorUpdates, Plugin):
         Param("serviceName", str, None, "std_srvs/Empty calibrate service, zeroes the rate drift (default: "
               "topicName/calibrate)", warn_if_missing=False),
         non_negative("gaussianNoise", float, 0.0, "when not 0: the accel and rate noise on every axis",
-                     warn_if_missing=False),
+                     warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, no effect (as upstream)", warn_if_missing=False),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation", warn_if_missing=False),
         non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),

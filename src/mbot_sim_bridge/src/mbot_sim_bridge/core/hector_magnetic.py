@@ -18,7 +18,7 @@ from . import names
 from .geometry import rotation_matrix
 from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from .params import Param, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, non_negative
 from .plugin import Plugin
 
 
@@ -36,7 +36,8 @@ class HectorMagnetic(HectorUpdates, Plugin):
         Param("topicName", str, "magnetic", "geometry_msgs/Vector3Stamped (or MagneticField)", warn_if_missing=False),
         Param("bodyName", str, None, "link measured; absent: the model's root link", warn_if_missing=False),
         Param("frameId", str, None, "frame_id (default: bodyName)", warn_if_missing=False),
-        non_negative("magnitude", float, 1.0, "field strength (the message's unit)", warn_if_missing=False),
+        non_negative("magnitude", float, 1.0, "field strength (the message's unit)", warn_if_missing=False,
+                     maximum=ERROR_MODEL_LIMIT),
         Param("referenceHeading", float, 0.0, "degrees clockwise from north of the world's x axis",
               warn_if_missing=False),
         Param("declination", float, 0.0, "degrees", warn_if_missing=False),

@@ -13,7 +13,7 @@ from typing import Dict, Sequence, Tuple
 import numpy as np
 
 from .errors import ConfigError
-from .params import Param
+from .params import ERROR_MODEL_LIMIT as LIMIT, Param
 from .xml_values import parse_floats
 
 # driftFrequency's default: a one-hour time constant.
@@ -36,13 +36,14 @@ def _tag(prefix: str, suffix: str) -> str:
 def sensor_model_params(prefix: str, size: int, quantity: str) -> Tuple[Param, ...]:
     """The five tags of a model; vectors (size 3) are read as text and checked by ``SensorModel.from_params``."""
     params = []
-    for suffix, default, _, meaning in _FIELDS:
+    for suffix, default, non_negative, meaning in _FIELDS:
         if size == 1:
             params.append(Param(_tag(prefix, suffix), float, default, f"{quantity}: {meaning}",
-                                warn_if_missing=False))
+                                warn_if_missing=False, minimum=0.0 if non_negative else -LIMIT, maximum=LIMIT))
         else:
+            low = "0" if non_negative else f"-{LIMIT:g}"
             params.append(Param(_tag(prefix, suffix), str, " ".join([f"{default:g}"] * size),
-                                f"{quantity}: {meaning}, per axis", warn_if_missing=False))
+                                f"{quantity}: {meaning}, per axis, each {low} to {LIMIT:g}", warn_if_missing=False))
     return tuple(params)
 
 
@@ -71,6 +72,8 @@ class SensorModel:
                     raise ConfigError(f"{where}: <{tag}> has bad value '{value}': {error}") from None
             if non_negative and np.any(np.asarray(value) < 0):
                 raise ConfigError(f"{where}: <{tag}> has bad value '{values[tag]}': must be >= 0")
+            if np.any(np.abs(np.asarray(value)) > LIMIT):
+                raise ConfigError(f"{where}: <{tag}> has bad value '{values[tag]}': must be at most {LIMIT:g} in size")
             fields.append(value)
         return cls(*fields, rng)
 

@@ -16,6 +16,10 @@ from .xml_values import check_range, describe_range, parse_bool, parse_float, pa
 
 _logger = get_logger(__name__)
 
+# The largest error model value (noise, drift, offset, scale) a sensor tag may give: far beyond any sensor, and
+# small enough that the products a sensor model forms stay finite.
+ERROR_MODEL_LIMIT = 1e6
+
 _PARSERS: Dict[type, Callable[[str], Any]] = {bool: parse_bool, float: parse_float, int: parse_int, str: str.strip}
 
 

@@ -18,7 +18,7 @@ from .clock import UpdateTimer
 from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, update_timer
 from .hector_sensor_model import SensorModel, sensor_model_params
 from .lidar import RaySensor
-from .params import Param, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, non_negative
 
 ULTRASOUND, INFRARED = 0, 1  # sensor_msgs/Range radiation types
 
@@ -39,7 +39,7 @@ class RangeSensor(RaySensor):
         Param("radiation", str, "ultrasound", "ultrasound; anything else is infrared"),
         non_negative("fov", float, 0.05, "rad; the message's field_of_view"),
         non_negative("gaussianNoise", float, 0.0, "m; stddev added to a reading below max_range",
-                     warn_if_missing=False),
+                     warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         non_negative("updateRate", float, 0.0, "Hz throttle on top of the sensor's update_rate; 0 = none",
                      warn_if_missing=False),
     )

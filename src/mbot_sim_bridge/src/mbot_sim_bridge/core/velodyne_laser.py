@@ -17,7 +17,7 @@ import numpy as np
 
 from . import names
 from .lidar import RaySensor
-from .params import Param, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, non_negative
 
 
 class VelodyneCloud(NamedTuple):
@@ -42,7 +42,8 @@ class VelodyneLaser(RaySensor):
         non_negative("max_range", float, math.inf, "m; farther readings are dropped", warn_if_missing=False),
         Param("min_intensity", float, -math.inf, "readings of less intensity are dropped (intensity is 0 here)",
               warn_if_missing=False),
-        non_negative("gaussianNoise", float, 0.0, "m; stddev added to each kept range", warn_if_missing=False),
+        non_negative("gaussianNoise", float, 0.0, "m; stddev added to each kept range", warn_if_missing=False,
+                     maximum=ERROR_MODEL_LIMIT),
         Param("organize_cloud", bool, False, "true: rows of rings with NaN where nothing was read",
               warn_if_missing=False),
     )

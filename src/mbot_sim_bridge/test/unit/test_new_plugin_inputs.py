@@ -1,0 +1,107 @@
+"""NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
+hector IMU/GPS/magnetometer, range, sonar, bumper): each value is refused with one line, or runs without an
+exception, and a robot two metres away does not move by 1 mm."""
+import math
+import re
+import warnings
+
+import pytest
+import xacro
+from sensor_fixtures import box, world_simulation
+from test_bumper import LUMPED, ROBOT as BUMPER_ROBOT
+from test_hector import BOX as HECTOR_ROBOT
+from test_planar_move import BASE as HOLONOMIC_XACRO
+from test_range import HECTOR_PLUGIN, RANGE_PLUGIN, ROBOT as SONAR_ROBOT, SONAR
+from test_skid_steer import BASE as SKID_XACRO
+
+from mbot_sim_bridge.core.errors import BridgeError
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+from mbot_sim_bridge.core.robot_model import parse_robot
+
+BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
+BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-300")
+BYSTANDER = """<robot name="crate"><link name="crate"><inertial><mass value="1"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link></robot>"""
+
+
+def run(tmp_path, urdf, command=None, steps=300):
+    """Spawn ``urdf`` beside a dynamic crate, send ``command`` to its drive, step: the crate's displacement, or
+    None when the spawn was refused (ConfigError/ModelError with one line)."""
+    sim = world_simulation(tmp_path, box("wall", (1.2, 0.0, 0.5), (0.1, 4.0, 1.0)))
+    try:
+        sim.spawn_robot(parse_robot(BYSTANDER, "model 'crate'"), "crate", pose_from_xyz_rpy((2, 2, 0.15), (0, 0, 0)))
+        sim.step(100)
+        start = sim.engine.model_pose("crate").position
+        try:
+            spawned = sim.spawn_robot(parse_robot(urdf, "model 'robot'"), "robot")
+        except BridgeError:
+            return None
+        if command is not None:
+            for plugin in spawned.plugins:
+                if hasattr(plugin, "set_command"):
+                    command(plugin)
+        plugins = list(spawned.plugins)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # an overflow inside a plugin would make it raise
+            sim.step(steps)
+        assert spawned.plugins == plugins  # a plugin that raised would have been dropped
+        return math.dist(start, sim.engine.model_pose("crate").position)
+    finally:
+        sim.close()
+
+
+@pytest.fixture(scope="module")
+def drives():
+    return {"planar": xacro.process_file(HOLONOMIC_XACRO, mappings={}).toxml(),
+            "skid": xacro.process_file(SKID_XACRO, mappings={}).toxml()}
+
+
+@pytest.mark.parametrize("value", BAD_VALUES)
+@pytest.mark.parametrize("drive, axis", [("planar", 0), ("planar", 1), ("planar", 2), ("skid", 0), ("skid", 1)])
+def test_drive_commands(tmp_path, drives, drive, axis, value):
+    command = [0.0] * (3 if drive == "planar" else 2)
+    command[axis] = value
+    moved = run(tmp_path, drives[drive], lambda plugin: plugin.set_command(*command))
+    assert moved < 1e-3
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("drive, tag", [("skid", "torque"), ("skid", "wheelDiameter"), ("skid", "wheelSeparation"),
+                                        ("skid", "updateRate"), ("skid", "covariance_yaw"),
+                                        ("planar", "odometryRate"), ("planar", "cmdTimeout")])
+def test_drive_tags(tmp_path, drives, drive, tag, text):
+    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", drives[drive])
+    command = (lambda plugin: plugin.set_command(0.5, 0.0, 0.5)) if drive == "planar" else (
+        lambda plugin: plugin.set_command(0.5, 0.5))
+    moved = run(tmp_path, urdf, command)
+    assert moved is None or moved < 1e-3
+
+
+SONARS = (SONAR.format(name="front", plugin=RANGE_PLUGIN.format(radiation="ultrasound", noise=0))
+          + SONAR.format(name="rear", plugin=HECTOR_PLUGIN.format(noise=0)))
+SENSOR_ROBOTS = {"hector": HECTOR_ROBOT.format(heading=0, imu="", gps=""),
+                 "sonar": SONAR_ROBOT.format(sensors=SONARS), "bumper": BUMPER_ROBOT.format(collision=LUMPED)}
+HECTOR_FILES = ("libhector_gazebo_ros_imu.so", "libhector_gazebo_ros_gps.so", "libhector_gazebo_ros_magnetic.so")
+SENSOR_TAGS = [("hector", tag) for tag in ("updateRate", "gaussianNoise", "magnitude", "inclination", "declination",
+                                           "referenceHeading", "referenceLatitude", "referenceAltitude", "accelDrift",
+                                           "rateDriftFrequency", "driftFrequency", "scaleError", "offset",
+                                           "velocityGaussianNoise", "yawDrift")] + [
+    ("sonar", tag) for tag in ("fov", "gaussianNoise", "updateRate", "min", "max", "samples")] + [
+    ("bumper", "update_rate")]
+VECTOR_TAGS = {"accelDrift", "rateDriftFrequency", "driftFrequency", "scaleError", "offset",
+               "velocityGaussianNoise"}
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("robot, tag", SENSOR_TAGS)
+def test_sensor_tags(tmp_path, robot, tag, text):
+    value = " ".join([text] * 3) if tag in VECTOR_TAGS else text
+    urdf = SENSOR_ROBOTS[robot]
+    if f"<{tag}>" in urdf:
+        urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{value}</{tag}>", urdf)
+    else:
+        for filename in HECTOR_FILES:
+            urdf = urdf.replace(f'filename="{filename}">', f'filename="{filename}"><{tag}>{value}</{tag}>')
+    moved = run(tmp_path, urdf)
+    assert moved is None or moved < 1e-3
