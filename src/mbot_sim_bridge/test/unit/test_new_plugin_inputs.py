@@ -1,7 +1,8 @@
 """NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
-hector IMU/GPS/magnetometer, range, sonar, bumper): each value is refused with one line, or runs without an
+hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne): each value is refused with one line, or runs without an
 exception, and a robot two metres away does not move by 1 mm."""
 import math
+import os
 import re
 import warnings
 
@@ -13,11 +14,13 @@ from test_hector import BOX as HECTOR_ROBOT
 from test_planar_move import BASE as HOLONOMIC_XACRO
 from test_range import HECTOR_PLUGIN, RANGE_PLUGIN, ROBOT as SONAR_ROBOT, SONAR
 from test_skid_steer import BASE as SKID_XACRO
+from test_velodyne import ROBOTS, STAND
 
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
 from mbot_sim_bridge.core.robot_model import parse_robot
 
+VLP16_MACRO = os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro"))
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
 BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-300")
 BYSTANDER = """<robot name="crate"><link name="crate"><inertial><mass value="1"/>
@@ -49,6 +52,21 @@ def run(tmp_path, urdf, command=None, steps=300):
         return math.dist(start, sim.engine.model_pose("crate").position)
     finally:
         sim.close()
+
+
+@pytest.fixture(scope="module")
+def velodyne_urdf(tmp_path_factory):
+    path = tmp_path_factory.mktemp("velodyne") / "stand.urdf.xacro"
+    path.write_text(STAND.format(macro=VLP16_MACRO, noise=0.008, organize="true"))
+    return xacro.process_file(str(path)).toxml()
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("tag", ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples"])
+def test_velodyne_tags(tmp_path, velodyne_urdf, tag, text):
+    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", velodyne_urdf)
+    moved = run(tmp_path, urdf)
+    assert moved is None or moved < 1e-3
 
 
 @pytest.fixture(scope="module")
