@@ -8,13 +8,8 @@ from ..core.skid_steer_drive import SkidSteerDrive
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
 from .gazebo_ros_diff_drive import on_twist
+from .messages import diagonal_covariance
 from .ground_truth_odometry import OdometryOutput
-
-
-def _covariance(x: float, y: float, yaw_variance: float) -> list:
-    covariance = [0.0] * 36
-    covariance[0::7] = [x, y, 1e12, 1e12, 1e12, yaw_variance]
-    return covariance
 
 
 class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):
@@ -23,7 +18,8 @@ class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):
         params = self.params
         namespace = self.robot_namespace()
         prefix = tf_prefix(context.simulation.parameters, namespace)
-        covariance = _covariance(params["covariance_x"], params["covariance_y"], params["covariance_yaw"])
+        covariance = diagonal_covariance((params["covariance_x"], params["covariance_y"], 1e12, 1e12, 1e12,
+                                          params["covariance_yaw"]), 6)
         self.output = OdometryOutput(self.topics, resolve_in_namespace(namespace, params["odometryTopic"]),
                                      resolve_frame(params["odometryFrame"], prefix),
                                      resolve_frame(params["robotBaseFrame"], prefix), covariance,

@@ -10,7 +10,7 @@ from sensor_msgs.msg import NavSatFix
 from ..core.hector_gps import HectorGps
 from ..core.log import get_logger, info_once
 from . import RosPlugin, resolve_in_namespace, ros_time
-from .messages import set_xyz
+from .messages import diagonal_covariance, set_xyz
 
 _logger = get_logger(__name__)
 
@@ -38,8 +38,7 @@ class HectorGazeboRosGps(RosPlugin, HectorGps):
         fix.header.frame_id = self.frame_id
         fix.status.status, fix.status.service = self.params["status"], self.params["service"]
         fix.latitude, fix.longitude, fix.altitude = reading.latitude, reading.longitude, reading.altitude
-        fix.position_covariance = [reading.position_covariance[0], 0.0, 0.0, 0.0, reading.position_covariance[1],
-                                   0.0, 0.0, 0.0, reading.position_covariance[2]]
+        fix.position_covariance = diagonal_covariance(reading.position_covariance, 3)
         fix.position_covariance_type = NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN
         self.fix_publisher.publish(fix)
         velocity = Vector3Stamped()

@@ -10,7 +10,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from ..core.hector_imu import HectorImu
 from ..core.log import get_logger, info_once
 from . import RosPlugin, resolve_in_namespace, ros_time
-from .messages import set_quaternion, set_xyz
+from .messages import diagonal_covariance, set_quaternion, set_xyz
 
 _logger = get_logger(__name__)
 
@@ -23,10 +23,6 @@ def _imu(stamp, frame_id, orientation, angular_velocity, linear_acceleration) ->
     set_xyz(message.angular_velocity, angular_velocity)
     set_xyz(message.linear_acceleration, linear_acceleration)
     return message
-
-
-def _diagonal(values):
-    return [values[0], 0.0, 0.0, 0.0, values[1], 0.0, 0.0, 0.0, values[2]]
 
 
 class HectorGazeboRosImu(RosPlugin, HectorImu):
@@ -60,9 +56,9 @@ class HectorGazeboRosImu(RosPlugin, HectorImu):
         if self.topics.listened(self.publisher):
             message = _imu(now, self.frame_id, reading.orientation, reading.angular_velocity,
                            reading.linear_acceleration)
-            message.orientation_covariance = _diagonal(reading.orientation_covariance)
-            message.angular_velocity_covariance = _diagonal(reading.angular_velocity_covariance)
-            message.linear_acceleration_covariance = _diagonal(reading.linear_acceleration_covariance)
+            message.orientation_covariance = diagonal_covariance(reading.orientation_covariance, 3)
+            message.angular_velocity_covariance = diagonal_covariance(reading.angular_velocity_covariance, 3)
+            message.linear_acceleration_covariance = diagonal_covariance(reading.linear_acceleration_covariance, 3)
             self.publisher.publish(message)
         if self.topics.listened(self.bias_publisher):
             self.bias_publisher.publish(_imu(now, self.frame_id, reading.orientation_error, reading.rate_bias,

@@ -23,10 +23,10 @@ def set_pose(pose, position: Sequence[float], orientation: Sequence[float]):
     set_quaternion(pose.orientation, orientation)
 
 
-def diagonal_covariance(variance: float, size: int) -> list:
-    """A row-major ``size`` x ``size`` covariance with ``variance`` on the diagonal."""
+def diagonal_covariance(variances, size: int) -> list:
+    """A row-major ``size`` x ``size`` covariance with ``variances`` on the diagonal (one value: on all of it)."""
     covariance = [0.0] * (size * size)
-    covariance[::size + 1] = [variance] * size
+    covariance[::size + 1] = list(variances) if isinstance(variances, (list, tuple)) else [variances] * size
     return covariance
 
 

@@ -20,15 +20,9 @@ from ..core.log import get_logger, warn_once
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame
 from . import loop_publisher, resolve_in_namespace
+from .messages import diagonal_covariance
 
 _logger = get_logger(__name__)
-
-
-def _diagonal(values):
-    covariance = [0.0] * 36
-    for index, value in enumerate(values):
-        covariance[index * 7] = value
-    return covariance
 
 
 class RosJointStateController(JointStateController):
@@ -92,9 +86,9 @@ class RosDiffDriveController(DiffDriveController):
         pose = message.pose.pose
         pose.position.x, pose.position.y = odometry.x, odometry.y
         pose.orientation.z, pose.orientation.w = math.sin(odometry.heading / 2), math.cos(odometry.heading / 2)
-        message.pose.covariance = _diagonal(self.pose_covariance)
+        message.pose.covariance = diagonal_covariance(self.pose_covariance, 6)
         message.twist.twist.linear.x, message.twist.twist.angular.z = odometry.linear, odometry.angular
-        message.twist.covariance = _diagonal(self.twist_covariance)
+        message.twist.covariance = diagonal_covariance(self.twist_covariance, 6)
         self.odom_publisher.publish(message)
         if self.enable_odom_tf:
             transform = TransformStamped()
