@@ -3,16 +3,18 @@
 package:// STL and COLLADA files, drives at the commanded speed (ground truth); the hector IMU reads gravity up
 at rest; the hector GPS fix moves north by the distance driven (x is north at referenceHeading 0); the
 VLP-16-style lidar publishes 16 rings. A holonomic base beside it (planar move) moves sideways at the
-commanded speed and its odometry says so; a skid-steer base (skid steer plugin) drives forward at the
-commanded speed."""
+commanded speed and its odometry says so; its front sonar reads a crate spawned 1 m ahead, and its bumper
+reports the crate by Gazebo's collision names once driven into it, with the normal towards the base, and
+nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed."""
 import math
 import unittest
 
 import rospy
 import rostest
 from controller_manager_msgs.srv import ListControllers
-from gazebo_msgs.srv import GetModelState
-from geometry_msgs.msg import Twist
+from gazebo_msgs.msg import ContactsState
+from gazebo_msgs.srv import GetModelState, SpawnModel
+from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix, PointCloud2, Range
 from sensor_msgs import point_cloud2
@@ -23,6 +25,14 @@ CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
 EQUATORIAL_RADIUS, EXCENTRICITY2 = 6378137.0, 0.00669437999013
 REFERENCE_LATITUDE = math.radians(49.9)
+# A crate as tall as the holonomic base's sonars, 1 m ahead of its front sonar (at x = +0.26 on the base).
+CRATE_SIZE = (0.4, 1.0, 0.5)
+CRATE_GAP = 1.0
+CRATE_SDF = f"""<sdf version="1.6"><model name="crate"><link name="link">
+  <inertial><mass>20</mass></inertial>
+  <collision name="collision"><geometry><box><size>{' '.join(map(str, CRATE_SIZE))}</size></box></geometry></collision>
+  <visual name="visual"><geometry><box><size>{' '.join(map(str, CRATE_SIZE))}</size></box></geometry></visual>
+</link></model></sdf>"""
 
 
 def north_radius():
@@ -147,7 +157,44 @@ class Rover(unittest.TestCase):
         # Nothing within 3 m (the ground is farther for their lowest rays): both read max_range.
         self.assertEqual((front.range, rear.range), (3.0, 3.0))
 
-    def test_6_skid_steer_base_drives_forward(self):
+    def test_6_holonomic_base_reads_a_crate_ahead_and_bumps_into_it(self):
+        bumper = Latest("/holonomic/bumper", ContactsState)
+        start = self.get_model_state("holonomic_base", "world").pose.position
+        wait_for(lambda: bumper.since(rospy.Time.now()), what="a bumper message")
+        self.assertEqual(bumper.message.states, [])  # nothing touches it yet
+        crate = Pose()
+        crate.position.x, crate.position.y = start.x + 0.26 + CRATE_GAP + CRATE_SIZE[0] / 2, start.y
+        crate.position.z, crate.orientation.w = CRATE_SIZE[2] / 2, 1.0
+        spawn = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)
+        self.assertTrue(spawn("crate", CRATE_SDF, "", crate, "world").success)
+        spawned = rospy.Time.now()
+        front = Latest("/holonomic/sonar_front", Range)
+        wait_for(lambda: len(front.since(spawned)) >= 5, what="five sonar readings of the crate")
+        readings = sorted(message.range for message in front.since(spawned))
+        median = readings[len(readings) // 2]
+        self.figures.append(f"holonomic front sonar, crate {CRATE_GAP} m ahead: median {median:.4f} m of "
+                            f"{len(readings)} readings (noise sigma 0.005)")
+        self.assertAlmostEqual(median, CRATE_GAP, delta=0.01)
+
+        command = rospy.Publisher("/holonomic/cmd_vel", Twist, queue_size=1)
+        twist = Twist()
+        twist.linear.x = 0.5
+
+        def touching():
+            command.publish(twist)
+            return next((state for message in bumper.since(spawned) for state in message.states), None)
+        state = wait_for(touching, what="the bumper to touch the crate")
+        self.drive(0.0, 0.3, command)
+        collisions = (state.collision1_name, state.collision2_name)
+        normal = state.contact_normals[0]
+        self.figures.append(f"holonomic bumper: {collisions[0]} against {collisions[1]}, {len(state.contact_normals)} "
+                            f"points, normal ({normal.x:.3f}, {normal.y:.3f}, {normal.z:.3f})")
+        plate = "holonomic_base::base_footprint::base_footprint_fixed_joint_lump__bumper_link_collision"
+        self.assertEqual(collisions, (plate, "crate::link::collision"))
+        self.assertLess(normal.x, -0.99)  # from the crate back towards the base
+        self.assertEqual(bumper.message.header.frame_id, "bumper_link")
+
+    def test_7_skid_steer_base_drives_forward(self):
         command = rospy.Publisher("/skid/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/skid/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the skid steer plugin")
