@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Scale figures, each as raw, bridge and their ratio (``./mbot bench``):
 
-- ten lidar mbots turning in the play ground: raw is the Simulation with the plugins' core classes (the same
-  PyBullet stepping, wheel control and ray casts, no ROS); the bridge is multi_mbot.launch count:=10 at real-time
-  factor 0 with every scan and odometry subscribed;
+- 1, 10 and 50 lidar mbots turning in the play ground (the scaling row; ten is the issue table's row): raw is
+  the Simulation with the plugins' core classes (the same PyBullet stepping, wheel control and ray casts, no
+  ROS); the bridge is multi_mbot.launch count:=N at real-time factor 0 with every scan and odometry subscribed;
 - a world of 5,000 static boxes: raw is the PyBullet world stepped alone; the bridge loads it at real-time
   factor 0 with every topic (model_states included) subscribed.
 Real-time factors are sim seconds per wall second; the bridge's is read from /clock over the window.
@@ -20,11 +20,11 @@ from rosgraph_msgs.msg import Clock
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
-ROBOTS = 10
+ROBOT_COUNTS = (1, 10, 50)
 BOXES = 5000
 
 
-def raw_robots_rtf(sim_seconds: float) -> float:
+def raw_robots_rtf(robots: int, sim_seconds: float) -> float:
     import xacro
     from mbot_sim_bridge.core.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
@@ -36,7 +36,7 @@ def raw_robots_rtf(sim_seconds: float) -> float:
     urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
                                            "mbot_with_laser_gazebo.xacro"), mappings={}).toxml()
     sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), CORE_PLUGINS)
-    for index in range(ROBOTS):  # the places and turn rates of multi_mbot.launch and the bridge run below
+    for index in range(robots):  # the places and turn rates of multi_mbot.launch and the bridge run below
         place = pose_from_xyz_rpy((-1.0 + 0.8 * (index % 5), -0.5 + 1.0 * (index // 5), 0), (0, 0, 0))
         spawned = sim.spawn_robot(parse_robot(urdf), f"mbot_{index + 1}", place)
         next(p for p in spawned.plugins if isinstance(p, DiffDrive)).set_command(0.0, turn_rate(index))
@@ -112,7 +112,8 @@ def main():
     from geometry_msgs.msg import Twist
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each raw run")
+    parser.add_argument("--sim-seconds", type=float, default=5.0,
+                        help="sim time of each raw run of up to ten robots (fewer for more robots)")
     parser.add_argument("--box-sim-seconds", type=float, default=0.5, help="sim time of the raw box-world run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each bridge run is measured")
     args = parser.parse_args()
@@ -121,7 +122,7 @@ def main():
         print(f"{what}: raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}", flush=True)
 
     # The raw runs go first: once rospy is up, the plugins' rosDebugLevel Debug would print every tag read.
-    raw_robots = raw_robots_rtf(args.sim_seconds)
+    raw_robots = {count: raw_robots_rtf(count, args.sim_seconds * min(1.0, 10 / count)) for count in ROBOT_COUNTS}
     with tempfile.TemporaryDirectory() as directory:
         world = os.path.join(directory, "boxes.world")
         box_world(world)
@@ -129,15 +130,17 @@ def main():
         with PrivateMaster() as master:
             os.environ["ROS_MASTER_URI"] = master.uri
             rospy.init_node("bench_scale", disable_signals=True)
-            commands = {}
-            for index in range(ROBOTS):
-                twist = Twist()
-                twist.angular.z = turn_rate(index)
-                commands[f"/mbot_{index + 1}/cmd_vel"] = twist
-            bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", f"count:={ROBOTS}",
-                                 "gui:=false", "real_time_factor:=0"],
-                                [f"/mbot_{n}/odom" for n in range(1, ROBOTS + 1)], args.wall_seconds, commands)
-            report(f"{ROBOTS} lidar mbots, real-time factor", raw_robots, bridge)
+            for count in ROBOT_COUNTS:
+                commands = {}
+                for index in range(count):
+                    twist = Twist()
+                    twist.angular.z = turn_rate(index)
+                    commands[f"/mbot_{index + 1}/cmd_vel"] = twist
+                bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", f"count:={count}",
+                                     "gui:=false", "real_time_factor:=0"],
+                                    [f"/mbot_{n}/odom" for n in range(1, count + 1)], args.wall_seconds, commands)
+                report(f"scaling, {count} lidar mbot{'s' if count > 1 else ''}, real-time factor", raw_robots[count],
+                       bridge)
             bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
                                  "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
             report(f"{BOXES} static boxes, real-time factor", raw_boxes, bridge)

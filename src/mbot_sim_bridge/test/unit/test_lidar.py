@@ -49,8 +49,6 @@ RPLIDAR = """
 """
 SENSOR = "lidar 'rplidar' on link 'laser_link'"
 MM = 0.005
-OWN_ROBOT_BIT = 1 << 8
-OTHER_ROBOT_BIT = 1 << 9
 
 
 def parse(xml: str = RPLIDAR) -> RaySensorConfig:
@@ -82,8 +80,8 @@ def add_box(client, half_extents, pose: Pose = IDENTITY, mass: float = 0.0) -> i
                                   basePosition=pose.position, baseOrientation=pose.orientation)
 
 
-def add_robot(client, group: int) -> int:
-    """A plate under the sensor and a mast 0.45 m ahead of it on a fixed joint; every link in ``group``."""
+def add_robot(client) -> int:
+    """A plate under the sensor and a mast 0.45 m ahead of it on a fixed joint."""
     plate = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[0.2, 0.2, 0.02])
     mast = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[0.05, 0.05, 0.3])
     body = client.createMultiBody(
@@ -92,13 +90,11 @@ def add_robot(client, group: int) -> int:
         linkPositions=[[0.5, 0, 0.2]], linkOrientations=[[0, 0, 0, 1]],
         linkInertialFramePositions=[[0, 0, 0]], linkInertialFrameOrientations=[[0, 0, 0, 1]],
         linkParentIndices=[0], linkJointTypes=[pybullet.JOINT_FIXED], linkJointAxis=[[0, 0, 1]])
-    for link in (-1, 0):
-        client.setCollisionFilterGroupMask(body, link, group, -1)
     return body
 
 
-def scan(client, config, pose=IDENTITY, mask=-1, seed=0):
-    return LaserScanner(client, config, np.random.default_rng(seed)).scan(pose, mask).ranges
+def scan(client, config, pose=IDENTITY, seed=0):
+    return LaserScanner(client, config, np.random.default_rng(seed)).scan(pose).ranges
 
 
 # --- parsing ---------------------------------------------------------------------------------------------
@@ -262,34 +258,12 @@ def test_beam_angles_run_counter_clockwise(client):
     assert set(np.flatnonzero(np.isfinite(ranges))) == {89, 90, 91, 269, 270, 271}
 
 
-def test_filter_mask_hides_own_robot_but_not_others(client):
-    config = full_circle()
-    add_robot(client, OWN_ROBOT_BIT)
-    other = add_box(client, [0.05, 0.2, 0.2], pose_from_xyz_rpy((1.05, 0, 0), (0, 0, 0)), mass=1.0)
-    client.setCollisionFilterGroupMask(other, -1, OTHER_ROBOT_BIT, -1)
+def test_rays_see_the_robots_own_links_as_in_gazebo(client):
+    add_robot(client)
     add_box(client, [0.05, 0.2, 0.2], pose_from_xyz_rpy((-1.55, 0, 0), (0, 0, 0)))
-    assert scan(client, config)[180] == pytest.approx(0.45, abs=MM)
-    ranges = scan(client, config, mask=-1 & ~OWN_ROBOT_BIT)
-    assert ranges[180] == pytest.approx(1.0, abs=MM)
+    ranges = scan(client, full_circle())
+    assert ranges[180] == pytest.approx(0.45, abs=MM)  # the mast the sensor's robot carries
     assert ranges[0] == pytest.approx(1.5, abs=MM)
-
-
-def test_pybullet_ray_filter_rule(client):
-    """pybullet 3.2.7 ray test: (group & ray mask) != 0 and (mask & 1) != 0, i.e. the ray is in group 1."""
-    ahead = noiseless(samples=1)
-    dynamic = add_box(client, [0.05, 0.2, 0.2], pose_from_xyz_rpy((1.05, 0, 0), (0, 0, 0)), mass=1.0)
-    static = add_box(client, [0.05, 0.2, 0.2], pose_from_xyz_rpy((2.05, 0, 0), (0, 0, 0)))
-    # PyBullet's defaults: dynamic bodies in group 1, mass-0 bodies in group 2.
-    assert scan(client, ahead, mask=1)[0] == pytest.approx(1.0, abs=MM)
-    assert scan(client, ahead, mask=2)[0] == pytest.approx(2.0, abs=MM)
-    client.setCollisionFilterGroupMask(dynamic, -1, OWN_ROBOT_BIT, -1)
-    assert scan(client, ahead, mask=OWN_ROBOT_BIT)[0] == pytest.approx(1.0, abs=MM)
-    assert scan(client, ahead, mask=-1 & ~OWN_ROBOT_BIT)[0] == pytest.approx(2.0, abs=MM)
-    # The object's mask is tested against the ray's group, 1: without that bit no ray sees it.
-    client.setCollisionFilterGroupMask(dynamic, -1, OWN_ROBOT_BIT, -1 & ~1)
-    assert scan(client, ahead, mask=-1)[0] == pytest.approx(2.0, abs=MM)
-    client.setCollisionFilterGroupMask(static, -1, 2, 2)
-    assert np.isposinf(scan(client, ahead, mask=-1)[0])
 
 
 def test_same_seed_gives_identical_noisy_scans():

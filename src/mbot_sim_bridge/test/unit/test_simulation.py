@@ -173,3 +173,18 @@ def test_reset_simulation_repeats_a_run_bit_for_bit(mbot_urdf, laser_mbot_urdf):
             other.close()
     finally:
         sim.close()
+
+
+def test_fifty_lidar_robots_share_a_world_and_each_scans(laser_mbot_urdf):
+    sim = simulation()
+    try:
+        model = parse_robot(laser_mbot_urdf, "model 'mbot'")
+        robots = [sim.spawn_robot(model, f"mbot_{index}", pose_from_xyz_rpy((index % 10, index // 10, 0), (0, 0, 0)))
+                  for index in range(50)]
+        sim.step(200)
+        scans = [plugin_of(spawned, RaySensor).scan().ranges for spawned in robots[:9]]
+        # A row of ten along x, 1 m apart: each laser but the last sees the next robot ahead, under 1 m away.
+        ahead = [ranges[len(ranges) // 2] for ranges in scans]
+        assert all(0.6 < distance < 1.0 for distance in ahead), ahead
+    finally:
+        sim.close()

@@ -28,9 +28,6 @@ MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
-# Collision-filter group bits handed to spawned robots, one bit each, so a robot's own sensors can skip it.
-_FIRST_ROBOT_GROUP_BIT = 4
-_LAST_ROBOT_GROUP_BIT = 30
 
 
 @dataclass
@@ -105,13 +102,12 @@ class SpawnedRobot:
     """A URDF robot in the engine, addressed by URDF link and joint names."""
 
     def __init__(self, client: BulletClient, name: str, model: RobotModel, body: int, namespace: str,
-                 collision_group: int, spawn_pose: Pose = IDENTITY):
+                 spawn_pose: Pose = IDENTITY):
         self.client = client
         self.name = name
         self.model = model
         self.body = body
         self.namespace = namespace
-        self.collision_group = collision_group
         self.spawn_pose = spawn_pose
         self.driven_joints: Tuple[str, ...] = ()
         self.loads = 1  # a new body (respawn) has every motor off, whatever a plugin set on the old one
@@ -254,8 +250,7 @@ class Engine:
         if name in self.robots or name in self.world_bodies:
             raise ModelError(f"model '{name}' already exists")
         check_state(f"SpawnModel: model '{name}'", pose)
-        robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace,
-                             self._free_collision_group(), pose)
+        robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace, pose)
         self._place(robot, driven_joints)
         return robot
 
@@ -266,8 +261,6 @@ class Engine:
         self._place(robot, robot.driven_joints)
 
     def _place(self, robot: SpawnedRobot, driven_joints: Optional[Sequence[str]]):
-        for index in robot.link_index.values():
-            self.client.setCollisionFilterGroupMask(robot.body, index, robot.collision_group, -1)
         if driven_joints is not None:
             self.set_surfaces(robot, driven_joints)
         for joint_name in robot.movable_joints:
@@ -416,14 +409,6 @@ class Engine:
             mu = 0.0
         self.client.changeDynamics(robot.body, index, lateralFriction=mu, spinningFriction=0.0,
                                    rollingFriction=0.0, restitution=0.0)
-
-    def _free_collision_group(self) -> int:
-        used = {robot.collision_group for robot in self.robots.values()}
-        for bit in range(_FIRST_ROBOT_GROUP_BIT, _LAST_ROBOT_GROUP_BIT + 1):
-            if (1 << bit) not in used:
-                return 1 << bit
-        bits = _LAST_ROBOT_GROUP_BIT - _FIRST_ROBOT_GROUP_BIT + 1
-        raise ModelError(f"too many robots: each needs a collision-filter bit and all {bits} are taken")
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)

@@ -203,19 +203,17 @@ class RaySensor(Plugin):
                             f"rays on the CPU, with the same ranges")
         self.scanner = LaserScanner(robot.client, self.config, context.random_stream(self.config.sensor_name))
         self.timer = UpdateTimer(self.config.update_rate, start=context.simulation.sim_time)
-        # Everything but this robot's own bit: the scan never sees the robot that carries the sensor.
-        self.collision_filter_mask = -1 & ~robot.collision_group
         self.latest: Optional[Scan] = None
 
     def sensor_world_pose(self) -> Pose:
         return compose(self.context.robot.link_world_pose(self.config.link), self.config.pose)
 
     def scan(self) -> "Scan":
-        return self.scanner.scan(self.sensor_world_pose(), self.collision_filter_mask)
+        return self.scanner.scan(self.sensor_world_pose())
 
     def raw_ranges(self) -> np.ndarray:
         """Every ray's raw range (the laser shape's, before the sensor's masking and noise)."""
-        return self.scanner.cast(self.sensor_world_pose(), self.collision_filter_mask)
+        return self.scanner.cast(self.sensor_world_pose())
 
     def update(self, now: float):
         self.latest = self.scan()
@@ -280,9 +278,10 @@ class LaserScanner:
     def config(self) -> RaySensorConfig:
         return self._config
 
-    def cast(self, sensor_pose_world: Pose, collision_filter_mask: int = -1) -> np.ndarray:
+    def cast(self, sensor_pose_world: Pose) -> np.ndarray:
         """Each ray's raw range, as Gazebo's laser shape gives it (``GetRange``): range_min plus the hit
-        distance, range_max for a miss; no masking, interpolation or noise. Rays as ``_ray_directions``."""
+        distance, range_max for a miss; no masking, interpolation or noise. Rays as ``_ray_directions``.
+        As in Gazebo, rays see every collision, the robot's own links included."""
         config = self._config
         rotation = np.asarray(rotation_matrix(sensor_pose_world.orientation))
         origin = np.asarray(sensor_pose_world.position)
@@ -291,25 +290,17 @@ class LaserScanner:
         fractions = np.empty(count)
         for first in range(0, count, _MAX_RAYS_PER_BATCH):
             last = min(first + _MAX_RAYS_PER_BATCH, count)
-            hits = self._client.rayTestBatch(points[first:last], points[count + first:count + last],
-                                             collisionFilterMask=collision_filter_mask)
+            hits = self._client.rayTestBatch(points[first:last], points[count + first:count + last])
             fractions[first:last] = [hit[2] for hit in hits]
         # Rays are cast from range_min; a miss (fraction 1) is set to range_max exactly, because
         # min + 1·(max − min) can round to just below max.
         return np.where(fractions >= 1.0, config.range_max,
                         config.range_min + fractions * (config.range_max - config.range_min))
 
-    def scan(self, sensor_pose_world: Pose, collision_filter_mask: int = -1) -> Scan:
-        """Scan from ``sensor_pose_world`` (link world pose ∘ ``config.pose``).
-
-        A ray sees a collision object only if (object group & collision_filter_mask) != 0 and
-        (object mask & 1) != 0: pybullet 3.2.7's ray test acts as collision group 1
-        (btBroadphaseProxy::DefaultFilter) with this mask. PyBullet puts dynamic bodies in group 1 and
-        mass-0 bodies in group 2, so to hide the robot that carries the sensor, give its links a group bit
-        of their own (not 1 or 2), keep 1 set in their masks, and pass ``-1 & ~robot_bit`` here.
-        """
+    def scan(self, sensor_pose_world: Pose) -> Scan:
+        """Scan from ``sensor_pose_world`` (link world pose ∘ ``config.pose``)."""
         config = self._config
-        raw = self.cast(sensor_pose_world, collision_filter_mask)
+        raw = self.cast(sensor_pose_world)
         if self._corners is not None:
             r1, r2, r3, r4 = raw[self._corners]
             hb, vb = self._h_weight, self._v_weight
