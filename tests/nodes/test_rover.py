@@ -5,7 +5,9 @@ at rest; the hector GPS fix moves north by the distance driven (x is north at re
 VLP-16-style lidar publishes 16 rings. A holonomic base beside it (planar move) moves sideways at the
 commanded speed and its odometry says so; its front sonar reads a crate spawned 1 m ahead, and its bumper
 reports the crate by Gazebo's collision names once driven into it, with the normal towards the base, and
-nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed."""
+nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed; a tricycle (tricycle
+plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
+ground ahead."""
 import math
 import unittest
 
@@ -16,7 +18,7 @@ from gazebo_msgs.msg import ContactsState
 from gazebo_msgs.srv import GetModelState, SpawnModel
 from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, NavSatFix, PointCloud2, Range
+from sensor_msgs.msg import Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
 from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for
@@ -25,6 +27,8 @@ CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
 EQUATORIAL_RADIUS, EXCENTRICITY2 = 6378137.0, 0.00669437999013
 REFERENCE_LATITUDE = math.radians(49.9)
+# The tricycle: wheelbase, and its block laser's height above the ground (axle 0.08 m, mast 0.3 m).
+TRICYCLE_WHEELBASE, BLOCK_LASER_HEIGHT = 0.5, 0.38
 # A crate as tall as the holonomic base's sonars, 1 m ahead of its front sonar (at x = +0.26 on the base).
 CRATE_SIZE = (0.4, 1.0, 0.5)
 CRATE_GAP = 1.0
@@ -206,6 +210,42 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(reported, 0.5, delta=0.025)
         header = odometry.message.header
         self.assertEqual((header.frame_id, odometry.message.child_frame_id), ("odom", "base_footprint"))
+
+    def test_8_tricycle_steers_as_its_kinematics_say(self):
+        command = rospy.Publisher("/tricycle/cmd_vel", Twist, queue_size=1)
+        odometry = Latest("/tricycle/odom", Odometry)
+        wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the tricycle plugin")
+        twist = Twist()
+        twist.linear.x, twist.angular.z = 0.4, 0.3  # wheel speed, steering angle
+        start = rospy.get_time()
+        # The plugin keeps the last command; it is sent until 1.5 s of sim time have passed.
+        wait_for(lambda: command.publish(twist) or rospy.get_time() > start + 1.5, what="1.5 s of sim time")
+        reported = odometry.message.twist.twist
+        expected_forward, expected_yaw_rate = 0.4 * math.cos(0.3), 0.4 * math.sin(0.3) / TRICYCLE_WHEELBASE
+        self.figures.append(f"tricycle (0.4 m/s, steering 0.3 rad): odometry {reported.linear.x:.3f} m/s for "
+                            f"{expected_forward:.3f}, {reported.angular.z:.3f} rad/s for {expected_yaw_rate:.3f}")
+        self.assertAlmostEqual(reported.linear.x, expected_forward, delta=0.05 * expected_forward)
+        self.assertAlmostEqual(reported.angular.z, expected_yaw_rate, delta=0.05 * expected_yaw_rate)
+        header = odometry.message.header
+        self.assertEqual((header.frame_id, odometry.message.child_frame_id), ("odom", "base_footprint"))
+        joints = rospy.wait_for_message("/tricycle/joint_states", JointState, timeout=WALL_TIMEOUT)
+        self.assertEqual(joints.name, ["front_steering_joint", "front_wheel_joint", "left_wheel_joint",
+                                       "right_wheel_joint"])
+        self.assertAlmostEqual(joints.position[0], 0.3, delta=0.005)
+        command.publish(Twist())
+
+    def test_9_tricycle_block_laser_sees_the_ground(self):
+        cloud = rospy.wait_for_message("/tricycle/block_cloud", PointCloud, timeout=WALL_TIMEOUT)
+        # The lowest row's rays point 0.2 rad down: each meets the ground h / sin(0.2) away, whatever its yaw
+        # (upstream places the point at the mid-angle of two rows, so the distance, not z, is the check).
+        ground = BLOCK_LASER_HEIGHT / math.sin(0.2)
+        lowest = [math.sqrt(point.x ** 2 + point.y ** 2 + point.z ** 2) for point in cloud.points[:64]]
+        self.figures.append(f"tricycle block laser: {len(cloud.points)} points in 8 rows, the lowest row "
+                            f"{min(lowest):.3f} to {max(lowest):.3f} m away (the ground {ground:.3f} m along it)")
+        self.assertEqual((len(cloud.points), len(cloud.channels), cloud.header.frame_id), (512, 1, "laser_link"))
+        self.assertEqual(len(cloud.channels[0].values), 512)
+        for distance in lowest:
+            self.assertAlmostEqual(distance, ground, delta=0.03)
 
 
 if __name__ == "__main__":

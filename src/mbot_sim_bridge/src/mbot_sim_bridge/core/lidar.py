@@ -185,7 +185,7 @@ def _check_consistency(config: RaySensorConfig, where: str) -> None:
 
 
 class RaySensor(Plugin):
-    """Core of libgazebo_ros_laser.so: the sensor's rays, cast from its link, never hitting its own robot."""
+    """Core of libgazebo_ros_laser.so: the sensor's rays, cast from its link."""
     NAMESPACE_RULE = names.SENSOR
 
     GAZEBO_CLASS = "GazeboRosLaser"

@@ -11,7 +11,7 @@ MODEL      the model name                the model name         diff_drive, join
 SENSOR     the simulator's ("/")         the model name         laser, camera, openni_kinect
 ROOT       "/"                           "/"                    imu (the model plugin), p3d, planar_move, skid_steer,
                                                                 range, bumper, hector imu, gps,
-                                                                magnetic and sonar, velodyne
+                                                                magnetic and sonar, velodyne, block_laser
 IMU_SENSOR "/" + the model name          "/"                    imu_sensor
 ========== ============================= ====================== ==============================================
 """

@@ -5,6 +5,7 @@ the benchmarks and the tests build their Simulations from it; adding a plugin ad
 """
 from typing import Dict
 
+from .block_laser import BlockLaser
 from .bumper import Bumper
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
@@ -19,6 +20,7 @@ from .p3d import P3D
 from .planar_move import PlanarMove
 from .range_sensor import HectorSonar, RangeSensor
 from .skid_steer_drive import SkidSteerDrive
+from .tricycle_drive import TricycleDrive
 from .velodyne_laser import VelodyneLaser
 
 CORE_PLUGINS: Dict[str, type] = {
@@ -35,6 +37,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_p3d.so": P3D,
     "libgazebo_ros_planar_move.so": PlanarMove,
     "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
+    "libgazebo_ros_tricycle_drive.so": TricycleDrive,
     "libhector_gazebo_ros_imu.so": HectorImu,
     "libhector_gazebo_ros_gps.so": HectorGps,
     "libhector_gazebo_ros_magnetic.so": HectorMagnetic,
@@ -43,6 +46,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libhector_gazebo_ros_sonar.so": HectorSonar,
     "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
     "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,
+    "libgazebo_ros_block_laser.so": BlockLaser,
 }
 
 
