@@ -7,7 +7,7 @@ commanded speed and its odometry says so; its front sonar reads a crate spawned 
 reports the crate by Gazebo's collision names once driven into it, with the normal towards the base, and
 nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed; a tricycle (tricycle
 plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
-ground ahead."""
+ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo."""
 import math
 import unittest
 
@@ -18,7 +18,7 @@ from gazebo_msgs.msg import ContactsState
 from gazebo_msgs.srv import GetModelState, SpawnModel
 from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
+from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
 from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for
@@ -96,7 +96,7 @@ class Rover(unittest.TestCase):
             (publisher or self.cmd_vel).publish(twist)
             rospy.rostime.wallsleep(0.02)
 
-    def test_1_imu_reads_gravity_up_at_rest(self):
+    def test_01_imu_reads_gravity_up_at_rest(self):
         # Half a second of readings (50 Hz) once the rover has settled after its landing.
         start = rospy.Time.now() + rospy.Duration(0.2)
         readings = wait_for(lambda: len(self.imu.since(start)) >= 25 and self.imu.since(start),
@@ -108,7 +108,7 @@ class Rover(unittest.TestCase):
         self.assertLess(math.hypot(mean[0], mean[1]), 0.05)
         self.assertEqual(readings[-1].header.frame_id, "imu_link")
 
-    def test_2_drives_at_the_commanded_speed_and_the_fix_follows_north(self):
+    def test_02_drives_at_the_commanded_speed_and_the_fix_follows_north(self):
         wait_for(lambda: self.fix.message, what="/navsat/fix")
         self.drive(0.5, 1.0)
         start, pose0, fix0 = rospy.get_time(), self.get_model_state("rover", "world").pose, self.fix.message
@@ -124,7 +124,7 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(north, driven, delta=0.01 * driven + 0.5 / 40)
         self.assertAlmostEqual(fix1.longitude, fix0.longitude, delta=1e-6)
 
-    def test_3_lidar_publishes_sixteen_rings(self):
+    def test_03_lidar_publishes_sixteen_rings(self):
         cloud = rospy.wait_for_message("/velodyne_points", PointCloud2, timeout=WALL_TIMEOUT)
         fields = [field.name for field in cloud.fields]
         self.assertEqual(fields, ["x", "y", "z", "intensity", "ring", "time"])
@@ -134,7 +134,7 @@ class Rover(unittest.TestCase):
         self.assertEqual(rings, set(range(8)))
         self.assertEqual(cloud.header.frame_id, "velodyne")
 
-    def test_4_holonomic_base_moves_sideways(self):
+    def test_04_holonomic_base_moves_sideways(self):
         command = rospy.Publisher("/holonomic/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/holonomic/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the planar move plugin")
@@ -149,7 +149,7 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(reported.y, 0.4, delta=0.004)  # within 1 %
         self.assertEqual(odometry.message.header.frame_id, "odom")
 
-    def test_5_holonomic_base_sonars(self):
+    def test_05_holonomic_base_sonars(self):
         front = rospy.wait_for_message("/holonomic/sonar_front", Range, timeout=WALL_TIMEOUT)
         rear = rospy.wait_for_message("/holonomic/sonar_rear", Range, timeout=WALL_TIMEOUT)
         self.figures.append(f"holonomic base sonars in the open: front {front.range:.3f} m (fov "
@@ -161,7 +161,7 @@ class Rover(unittest.TestCase):
         # Nothing within 3 m (the ground is farther for their lowest rays): both read max_range.
         self.assertEqual((front.range, rear.range), (3.0, 3.0))
 
-    def test_6_holonomic_base_reads_a_crate_ahead_and_bumps_into_it(self):
+    def test_06_holonomic_base_reads_a_crate_ahead_and_bumps_into_it(self):
         bumper = Latest("/holonomic/bumper", ContactsState)
         start = self.get_model_state("holonomic_base", "world").pose.position
         wait_for(lambda: bumper.since(rospy.Time.now()), what="a bumper message")
@@ -198,7 +198,7 @@ class Rover(unittest.TestCase):
         self.assertLess(normal.x, -0.99)  # from the crate back towards the base
         self.assertEqual(bumper.message.header.frame_id, "bumper_link")
 
-    def test_7_skid_steer_base_drives_forward(self):
+    def test_07_skid_steer_base_drives_forward(self):
         command = rospy.Publisher("/skid/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/skid/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the skid steer plugin")
@@ -211,7 +211,7 @@ class Rover(unittest.TestCase):
         header = odometry.message.header
         self.assertEqual((header.frame_id, odometry.message.child_frame_id), ("odom", "base_footprint"))
 
-    def test_8_tricycle_steers_as_its_kinematics_say(self):
+    def test_08_tricycle_steers_as_its_kinematics_say(self):
         command = rospy.Publisher("/tricycle/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/tricycle/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the tricycle plugin")
@@ -234,7 +234,7 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(joints.position[0], 0.3, delta=0.005)
         command.publish(Twist())
 
-    def test_9_tricycle_block_laser_sees_the_ground(self):
+    def test_09_tricycle_block_laser_sees_the_ground(self):
         cloud = rospy.wait_for_message("/tricycle/block_cloud", PointCloud, timeout=WALL_TIMEOUT)
         # The lowest row's rays point 0.2 rad down: each meets the ground h / sin(0.2) away, whatever its yaw
         # (upstream places the point at the mid-angle of two rows, so the distance, not z, is the check).
@@ -246,6 +246,20 @@ class Rover(unittest.TestCase):
         self.assertEqual(len(cloud.channels[0].values), 512)
         for distance in lowest:
             self.assertAlmostEqual(distance, ground, delta=0.03)
+
+    def test_10_stereo_head_publishes_both_cameras(self):
+        infos = {side: rospy.wait_for_message(f"/stereo_head/stereo/{side}/camera_info", CameraInfo,
+                                              timeout=WALL_TIMEOUT) for side in ("left", "right")}
+        images = {side: rospy.wait_for_message(f"/stereo_head/stereo/{side}/image_raw", Image, timeout=WALL_TIMEOUT)
+                  for side in ("left", "right")}
+        fx = infos["right"].P[0]
+        self.figures.append(f"stereo head: {images['left'].width}x{images['left'].height} {images['left'].encoding} "
+                            f"pair, right P[3] {infos['right'].P[3]:.3f} (fx {fx:.1f})")
+        self.assertEqual(infos["left"].P[3], 0.0)
+        self.assertAlmostEqual(infos["right"].P[3], -fx * 0.07, places=6)
+        for image in images.values():
+            self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
+                             (320, 240, "rgb8", "left_camera_optical_frame"))
 
 
 if __name__ == "__main__":

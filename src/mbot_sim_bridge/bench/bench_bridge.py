@@ -113,7 +113,8 @@ def main():
         print(f"roslaunch to first /odom: median {statistics.median(launches):.2f} s ({len(launches)} launches, "
               f"{launches[0]:.2f} to {launches[-1]:.2f} s)", flush=True)
     # The others, each in a process of its own (each starts its own master and rospy node).
-    for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_lidar3d.py", "bench_cameras.py"):
+    for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_lidar3d.py", "bench_stereo.py",
+                   "bench_cameras.py"):
         status = subprocess.call([sys.executable, os.path.join(HERE, script)])
         if status:
             sys.exit(status)

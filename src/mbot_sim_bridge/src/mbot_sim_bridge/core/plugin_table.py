@@ -16,6 +16,7 @@ from .hector_magnetic import HectorMagnetic
 from .imu import ImuModelPlugin, ImuSensor
 from .joint_states import JointStatePublisher
 from .lidar import RaySensor
+from .multicamera import MultiCamera
 from .p3d import P3D
 from .planar_move import PlanarMove
 from .range_sensor import HectorSonar, RangeSensor
@@ -30,6 +31,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_laser.so": RaySensor,
     "libgazebo_ros_gpu_laser.so": RaySensor,
     "libgazebo_ros_camera.so": Camera,
+    "libgazebo_ros_multicamera.so": MultiCamera,
     "libgazebo_ros_openni_kinect.so": DepthCamera,
     "libgazebo_ros_depth_camera.so": PlainDepthCamera,
     "libgazebo_ros_imu.so": ImuModelPlugin,
