@@ -7,7 +7,8 @@ commanded speed and its odometry says so; its front sonar reads a crate spawned 
 reports the crate by Gazebo's collision names once driven into it, with the normal towards the base, and
 nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed; a tricycle (tricycle
 plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
-ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo."""
+ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo, and
+its f3d reports a wrench /gazebo/apply_body_wrench puts on its base."""
 import math
 import unittest
 
@@ -15,8 +16,8 @@ import rospy
 import rostest
 from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.msg import ContactsState
-from gazebo_msgs.srv import GetModelState, SpawnModel
-from geometry_msgs.msg import Pose, Twist
+from gazebo_msgs.srv import ApplyBodyWrench, GetModelState, SpawnModel
+from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
@@ -260,6 +261,28 @@ class Rover(unittest.TestCase):
         for image in images.values():
             self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
                              (320, 240, "rgb8", "left_camera_optical_frame"))
+
+    def test_11_f3d_reports_an_applied_wrench(self):
+        wrenches = Latest("/stereo_head/base_wrench", WrenchStamped)
+        wait_for(lambda: wrenches.message, what="the f3d plugin")
+        self.assertEqual(wrenches.message.wrench.force.z, 0.0)
+        wrench = Wrench()
+        wrench.force.z, wrench.torque.z = 50.0, 2.0
+        apply = rospy.ServiceProxy("/gazebo/apply_body_wrench", ApplyBodyWrench)
+        start = rospy.Time.now()
+        response = apply(body_name="stereo_head::base_footprint", reference_frame="world", wrench=wrench,
+                         duration=rospy.Duration(0.5))
+        self.assertTrue(response.success, response.status_message)
+        during = wait_for(lambda: next((message for message in wrenches.since(start) if message.wrench.force.z), None),
+                          what="the applied wrench on the f3d topic")
+        self.figures.append(f"f3d under a 50 N, 2 N·m apply_body_wrench: force z {during.wrench.force.z:.1f} N, "
+                            f"torque z {during.wrench.torque.z:.2f} N·m")
+        self.assertEqual((during.wrench.force.z, during.wrench.torque.z, during.header.frame_id), (50.0, 2.0, "world"))
+        wait_for(lambda: rospy.Time.now() > start + rospy.Duration(0.6) and not wrenches.message.wrench.force.z,
+                 what="the wrench to end after its 0.5 s")
+        refused = apply(body_name="stereo_head::nowhere", wrench=wrench, duration=rospy.Duration(0.5))
+        self.assertFalse(refused.success)
+        self.assertIn("ApplyBodyWrench: body does not exist", refused.status_message)
 
 
 if __name__ == "__main__":

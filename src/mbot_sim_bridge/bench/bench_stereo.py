@@ -27,7 +27,8 @@ def spawn():
     import xacro
     path = os.path.join(WORKSPACE, "src", "mobile_test_robots", "urdf", "stereo_head.urdf.xacro")
     sim = Simulation(parse_world(PLAY_GROUND), CORE_PLUGINS)
-    spawned = sim.spawn_robot(parse_robot(xacro.process_file(path, mappings={}).toxml(), "model 'stereo_head'"), "stereo_head")
+    urdf = xacro.process_file(path, mappings={}).toxml()
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'stereo_head'"), "stereo_head")
     return sim, next(plugin for plugin in spawned.plugins if isinstance(plugin, MultiCamera))
 
 

@@ -14,6 +14,8 @@ UPSTREAM_MD5 = {
     srv.SpawnModel: "9ed9c82c96abe1a00c3e8cdaeee24413",
     srv.GetModelState: "4c515e936d3319c9610c559c60bfc3d4",
     srv.SetModelState: "5b3ab0281d4f5445def017e3a2e4a07b",
+    srv.ApplyBodyWrench: "585b9f9618aa0581b207e2f2d90866bc",
+    srv.BodyRequest: "5eade9afe7f232d78005bd0cafeab755",
 }
 
 

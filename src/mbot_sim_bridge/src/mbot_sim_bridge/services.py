@@ -9,7 +9,8 @@ from typing import Optional
 from xml.etree import ElementTree
 
 import rospy
-from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
+from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, BodyRequest, BodyRequestResponse,
+                             DeleteModel, DeleteModelResponse, GetModelState, GetModelStateResponse,
                              GetPhysicsProperties, GetPhysicsPropertiesResponse, GetWorldProperties,
                              GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
                              SpawnModelResponse)
@@ -80,6 +81,8 @@ class GazeboRosApi:
             rospy.Service("~unpause_physics", Empty, self._empty(lambda: node.set_paused(False))),
             rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
             rospy.Service("~reset_world", Empty, self._empty(lambda: node.reset(simulation=False))),
+            rospy.Service("~apply_body_wrench", ApplyBodyWrench, self._apply_body_wrench),
+            rospy.Service("~clear_body_wrenches", BodyRequest, self._clear_body_wrenches),
             rospy.Service("~step_simulation", StepSimulation, self._step_simulation),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
@@ -199,6 +202,22 @@ class GazeboRosApi:
             self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
+
+    # -- wrenches ----------------------------------------------------------------------------------------------
+    def _apply_body_wrench(self, request):
+        def apply():
+            values = [request.reference_point.x, request.reference_point.y, request.reference_point.z]
+            force, torque = request.wrench.force, request.wrench.torque
+            values += [force.x, force.y, force.z, torque.x, torque.y, torque.z]
+            start, duration = request.start_time.to_sec(), request.duration.to_sec()
+            self.sim.apply_body_wrench(request.body_name, request.reference_frame, values[:3], values[3:6],
+                                       values[6:], start, duration)
+            return ApplyBodyWrenchResponse(success=True, status_message="")
+        return self._guarded(ApplyBodyWrenchResponse, apply)
+
+    def _clear_body_wrenches(self, request):
+        self.node.call_in_loop(lambda: self.sim.clear_body_wrenches(request.body_name))
+        return BodyRequestResponse()
 
     def _get_world_properties(self, _request):
         def get():

@@ -301,6 +301,14 @@ class Engine:
         """World-frame (linear velocity of the model frame's origin, angular velocity)."""
         return frame_velocity(self.client, self.body_of(name), self.model_pose(name).position)
 
+    def apply_link_wrench(self, body: int, index: int, force, torque):
+        """A world-frame force at the link's centre of mass and a torque, for the next physics step only (as
+        Gazebo's Link::SetForce and SetTorque)."""
+        centre = (self.client.getBasePositionAndOrientation(body)[0] if index == -1
+                  else self.client.getLinkState(body, index)[0])
+        self.client.applyExternalForce(body, index, force, centre, pybullet.WORLD_FRAME)
+        self.client.applyExternalTorque(body, index, torque, pybullet.WORLD_FRAME)
+
     def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
         """Move a model's frame to ``pose`` and give every link the same world velocity (as Gazebo does)."""
         body = self.body_of(name)

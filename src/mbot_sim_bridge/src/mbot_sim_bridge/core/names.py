@@ -7,10 +7,11 @@ depend on those differences, so each plugin class names its rule (``Plugin.NAMES
 ========== ============================= ====================== ==============================================
 rule       absent                        empty                  plugins
 ========== ============================= ====================== ==============================================
-MODEL      the model name                the model name         diff_drive, joint_state_publisher, ros_control
-SENSOR     the simulator's ("/")         the model name         laser, camera, openni_kinect
-ROOT       "/"                           "/"                    imu (the model plugin), p3d, planar_move, skid_steer,
-                                                                range, bumper, hector imu, gps,
+MODEL      the model name                the model name         diff_drive, joint_state_publisher, ros_control,
+                                                                tricycle_drive
+SENSOR     the simulator's ("/")         the model name         laser, camera, multicamera, openni_kinect
+ROOT       "/"                           "/"                    imu (the model plugin), p3d, f3d, planar_move,
+                                                                skid_steer, range, bumper, hector imu, gps,
                                                                 magnetic and sonar, velodyne, block_laser
 IMU_SENSOR "/" + the model name          "/"                    imu_sensor
 ========== ============================= ====================== ==============================================

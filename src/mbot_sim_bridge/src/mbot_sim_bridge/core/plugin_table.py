@@ -9,6 +9,7 @@ from .block_laser import BlockLaser
 from .bumper import Bumper
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
+from .f3d import F3D
 from .gazebo_ros_control import GazeboRosControlPlugin
 from .hector_gps import HectorGps
 from .hector_imu import HectorImu
@@ -37,6 +38,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_imu.so": ImuModelPlugin,
     "libgazebo_ros_imu_sensor.so": ImuSensor,
     "libgazebo_ros_p3d.so": P3D,
+    "libgazebo_ros_f3d.so": F3D,
     "libgazebo_ros_planar_move.so": PlanarMove,
     "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
     "libgazebo_ros_tricycle_drive.so": TricycleDrive,

@@ -7,6 +7,7 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 ROS layer's registry derived from it, so the core never imports the ROS plugin layer.
 """
 import hashlib
+import math
 from dataclasses import dataclass, field, replace
 from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
@@ -14,9 +15,10 @@ from xml.etree import ElementTree
 import numpy as np
 import pybullet
 
+from .body_wrenches import WORLD_FRAMES, BodyWrenches, WrenchJob, target_wrench
 from .engine import Engine, SpawnedRobot
 from .errors import ConfigError, ModelError
-from .geometry import IDENTITY, Pose
+from .geometry import IDENTITY, Pose, compose, inverse
 from .joint_states import JointStatePublisher
 from .log import get_logger, warn_once
 from .parameters import Parameters
@@ -36,6 +38,8 @@ JOINT_STATE_PLUGIN = filename_of(JointStatePublisher)
 LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
 MAX_BATCH_SIM_SECONDS = 0.01
+# apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
+MAX_WRENCH = 1e6
 
 # Called before the due plugins update: (sim time, whether any plugin is due). The node publishes /clock there.
 BeforeUpdates = Callable[[float, bool], None]
@@ -77,6 +81,7 @@ class Simulation:
         self._every_step: List[Plugin] = []
         self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
+        self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -162,8 +167,72 @@ class Simulation:
             self._frozen.discard(name)
             self._schedule()
         self.world_models.pop(name, None)
+        self.wrenches.clear(name)
         self.engine.remove(name)
         self.version += 1
+
+    # -- wrenches from outside (apply_body_wrench) ---------------------------------------------------------------
+    def apply_body_wrench(self, body: str, reference_frame: str, reference_point, force, torque, start_time: float,
+                          duration: float):
+        """Schedule a wrench on link ``body`` ("model::link"), as gazebo_ros's apply_body_wrench (body_wrenches.py);
+        an unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite
+        or beyond MAX_WRENCH (the physics would turn the model's state NaN)."""
+        model, link = self._split_link(body, "ApplyBodyWrench: body does not exist")
+        values = [*reference_point, *force, *torque]
+        if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
+            raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
+                             f"at most {MAX_WRENCH:g} in size; got {values}")
+        frame_pose = None
+        if reference_frame not in WORLD_FRAMES:
+            frame_pose = self._entity_pose(reference_frame)
+            if frame_pose is None:
+                raise ModelError(f"ApplyBodyWrench: reference_frame '{reference_frame}' is not a valid entity name")
+        force, torque = target_wrench(force, torque, reference_point, self._link_pose(model, link), frame_pose)
+        self.wrenches.add(WrenchJob(model, link, force, torque, max(start_time, self.sim_time), duration))
+
+    def clear_body_wrenches(self, body: str):
+        model, _, link = body.partition("::")
+        self.wrenches.clear(model, link)
+
+    def link_names(self, model: str) -> List[str]:
+        """The links a model has in the physics (a robot's after lumping, a world model's own)."""
+        if model in self.models:
+            return list(self.models[model].robot.link_index)
+        if model in self.world_models:
+            return [link.name for link in self.world_models[model].links]
+        return []
+
+    def _split_link(self, body: str, failure: str) -> Tuple[str, str]:
+        model, _, link = body.partition("::")
+        if link not in self.link_names(model):
+            known = ", ".join(f"{model}::{name}" for name in self.link_names(model)) or "no such model"
+            raise ModelError(f"{failure}: '{body}' ({known})")
+        return model, link
+
+    def _link_pose(self, model: str, link: str) -> Pose:
+        if model in self.models:
+            return self.models[model].robot.link_world_pose(link)
+        description = self.world_models[model]
+        in_model = compose(inverse(description.pose), next(item.pose for item in description.links
+                                                           if item.name == link))
+        return compose(self.engine.model_pose(model), in_model)
+
+    def _entity_pose(self, name: str) -> Optional[Pose]:
+        """A model's or a "model::link"'s world pose, or None when there is no such entity."""
+        if name in self.model_names():
+            return self.engine.model_pose(name)
+        model, _, link = name.partition("::")
+        return self._link_pose(model, link) if link in self.link_names(model) else None
+
+    def _apply_wrenches(self):
+        for (model, link), (force, torque) in self.wrenches.due(self.sim_time).items():
+            if model in self._frozen:
+                continue
+            if model in self.models:
+                self.engine.apply_link_wrench(self.models[model].robot.body, self.models[model].robot.link_index[link],
+                                              force, torque)
+            else:
+                self.engine.apply_link_wrench(self.engine.body_of(model), -1, force, torque)
 
     def set_model_state(self, name: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
         """Move a model and set its velocity (set_model_state, set from outside the physics)."""
@@ -229,11 +298,16 @@ class Simulation:
             return 1
         now, step = self.sim_time, self.step_size
         batch = max(1, int(round(MAX_BATCH_SIM_SECONDS / step)))
+        wrench_steps = self.wrenches.steps_until_next(now, step)
+        if wrench_steps is not None:
+            batch = min(batch, wrench_steps)
         return min([batch] + [plugin.timer.steps_until_due(now, step) for plugin in self._plugins])
 
     def advance(self, max_steps: int, before_updates: Optional[BeforeUpdates] = None) -> int:
         """Step up to the next plugin event or ``max_steps``, then run the due updates; returns the steps taken."""
         count = max(1, min(max_steps, self.steps_to_next_event()))
+        if self.wrenches.pending() or self.wrenches.applied:
+            self._apply_wrenches()
         self.engine.step(count)
         broken = self.engine.robots_not_finite()
         if broken:

@@ -1,0 +1,96 @@
+"""Wrenches applied to links from outside, as gazebo_ros's ``/gazebo/apply_body_wrench`` and
+``/gazebo/clear_body_wrenches`` schedule them (gazebo_ros_pkgs noetic-devel ``gazebo_ros_api_plugin.cpp``).
+
+A job holds a link, a force and a torque (world frame) and a sim-time window. Before every physics step each job
+whose window holds the time sets its link's force (at the centre of mass) and torque, as Gazebo's SetForce and
+SetTorque: of several jobs on one link the last one wins. A job ends once the time passes start + duration; a
+negative duration never ends, one of 0 acts for the step at its start. What was applied in the last step is
+what ``libgazebo_ros_f3d.so`` reports (Gazebo's Link::WorldForce at the start of the next update).
+
+The request's wrench becomes the job's as upstream transforms it: the torque gains reference_point × force;
+with an empty, "world" or "map" reference_frame both stay as given; with an entity's frame both are rotated by
+that frame's orientation relative to the link, and the torque gains (frame position relative to the link) ×
+force. The result is applied in the world frame, so a wrench given in the link's own frame acts along the world
+axes (upstream's "FIXME map is really wrong").
+"""
+import threading
+from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .geometry import Pose, inverse, compose, rotate
+
+Vector = Tuple[float, float, float]
+ZERO = (0.0, 0.0, 0.0)
+WORLD_FRAMES = ("", "world", "map", "/map")
+
+
+class WrenchJob(NamedTuple):
+    model: str
+    link: str
+    force: Vector
+    torque: Vector
+    start: float
+    duration: float
+
+    def acts_at(self, now: float) -> bool:
+        return now >= self.start and (self.duration < 0 or now <= self.start + self.duration)
+
+    def ended_at(self, now: float) -> bool:
+        return self.duration >= 0 and now > self.start + self.duration
+
+
+def target_wrench(force: Sequence[float], torque: Sequence[float], reference_point: Sequence[float],
+                  body_pose: Pose, frame_pose: Optional[Pose]) -> Tuple[Vector, Vector]:
+    """The force and torque a request makes (see the module docstring); ``frame_pose`` None: a world frame."""
+    force = np.asarray(force, dtype=float)
+    torque = np.asarray(torque, dtype=float) + np.cross(reference_point, force)
+    if frame_pose is None:
+        return tuple(force.tolist()), tuple(torque.tolist())
+    relative = compose(inverse(body_pose), frame_pose)  # the frame in the link's frame
+    force = np.asarray(rotate(relative.orientation, force))
+    torque = np.asarray(rotate(relative.orientation, torque)) + np.cross(relative.position, force)
+    return tuple(force.tolist()), tuple(torque.tolist())
+
+
+class BodyWrenches:
+    """The scheduled jobs; requests arrive from ROS threads, the loop applies them."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._jobs: List[WrenchJob] = []
+        self.applied: Dict[Tuple[str, str], Tuple[Vector, Vector]] = {}
+
+    def add(self, job: WrenchJob):
+        with self._lock:
+            self._jobs.append(job)
+
+    def clear(self, model: str, link: Optional[str] = None):
+        """Drop the jobs of one link, or of every link of ``model`` (its deletion)."""
+        with self._lock:
+            self._jobs = [job for job in self._jobs if not (job.model == model and link in (None, job.link))]
+
+    def pending(self) -> bool:
+        return bool(self._jobs)
+
+    def steps_until_next(self, now: float, step_size: float) -> Optional[int]:
+        """1 while a job acts; the steps to the earliest start otherwise; None without jobs."""
+        with self._lock:
+            starts = [job.start for job in self._jobs]
+        if not starts:
+            return None
+        return max(1, int(np.ceil((min(starts) - now) / step_size - 1e-9)))
+
+    def due(self, now: float) -> Dict[Tuple[str, str], Tuple[Vector, Vector]]:
+        """(model, link) -> (force, torque) to apply in the step starting at ``now``; ended jobs are dropped."""
+        with self._lock:
+            acting = {}
+            for job in self._jobs:
+                if job.acts_at(now):
+                    acting[(job.model, job.link)] = (job.force, job.torque)
+            self._jobs = [job for job in self._jobs if not job.ended_at(now)]
+        self.applied = acting
+        return acting
+
+    def applied_to(self, model: str, link: str) -> Tuple[Vector, Vector]:
+        return self.applied.get((model, link), (ZERO, ZERO))
