@@ -8,7 +8,8 @@ reports the crate by Gazebo's collision names once driven into it, with the norm
 nothing before; a skid-steer base (skid steer plugin) drives forward at the commanded speed; a tricycle (tricycle
 plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
 ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo, and
-its f3d reports a wrench /gazebo/apply_body_wrench puts on its base."""
+its f3d reports a wrench /gazebo/apply_body_wrench puts on its base and its pan joint's ft sensor the head's
+weight."""
 import math
 import unittest
 
@@ -283,6 +284,15 @@ class Rover(unittest.TestCase):
         refused = apply(body_name="stereo_head::nowhere", wrench=wrench, duration=rospy.Duration(0.5))
         self.assertFalse(refused.success)
         self.assertIn("ApplyBodyWrench: body does not exist", refused.status_message)
+
+    def test_12_ft_sensor_reads_the_head_weight(self):
+        reading = rospy.wait_for_message("/stereo_head/pan_wrench", WrenchStamped, timeout=WALL_TIMEOUT)
+        force = reading.wrench.force
+        self.figures.append(f"stereo head pan ft sensor: force ({force.x:.3f}, {force.y:.3f}, {force.z:.3f}) N for the "
+                            f"0.5 kg head ({-0.5 * 9.8:.2f} N along z)")
+        self.assertEqual(reading.header.frame_id, "head_link")
+        self.assertAlmostEqual(force.z, -0.5 * 9.8, delta=0.02 * 0.5 * 9.8)
+        self.assertAlmostEqual(math.hypot(force.x, force.y), 0.0, delta=0.02 * 0.5 * 9.8)
 
 
 if __name__ == "__main__":

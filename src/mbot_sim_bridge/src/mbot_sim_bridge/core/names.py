@@ -10,9 +10,9 @@ rule       absent                        empty                  plugins
 MODEL      the model name                the model name         diff_drive, joint_state_publisher, ros_control,
                                                                 tricycle_drive
 SENSOR     the simulator's ("/")         the model name         laser, camera, multicamera, openni_kinect
-ROOT       "/"                           "/"                    imu (the model plugin), p3d, f3d, planar_move,
-                                                                skid_steer, range, bumper, hector imu, gps,
-                                                                magnetic and sonar, velodyne, block_laser
+ROOT       "/"                           "/"                    imu (the model plugin), p3d, f3d, ft_sensor,
+                                                                planar_move, skid_steer, range, bumper, hector
+                                                                imu, gps, magnetic and sonar, velodyne, block_laser
 IMU_SENSOR "/" + the model name          "/"                    imu_sensor
 ========== ============================= ====================== ==============================================
 """

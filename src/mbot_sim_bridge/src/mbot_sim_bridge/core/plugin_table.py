@@ -10,6 +10,7 @@ from .bumper import Bumper
 from .camera import Camera, DepthCamera, PlainDepthCamera
 from .diff_drive import DiffDrive
 from .f3d import F3D
+from .ft_sensor import FTSensor
 from .gazebo_ros_control import GazeboRosControlPlugin
 from .hector_gps import HectorGps
 from .hector_imu import HectorImu
@@ -39,6 +40,7 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_imu_sensor.so": ImuSensor,
     "libgazebo_ros_p3d.so": P3D,
     "libgazebo_ros_f3d.so": F3D,
+    "libgazebo_ros_ft_sensor.so": FTSensor,
     "libgazebo_ros_planar_move.so": PlanarMove,
     "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
     "libgazebo_ros_tricycle_drive.so": TricycleDrive,
