@@ -41,14 +41,15 @@ def insert(simulation, tmp_path, database_name, name, x, y):
 def window_pixel(client, point):
     """Where a world point appears in the window, from its camera's view and projection matrices (read again until
     the window has applied the camera: before that they are zero)."""
-    deadline = time.monotonic() + 30.0
+    deadline = time.monotonic() + 60.0
     while True:
         camera = client.getDebugVisualizerCamera()
         width, height = camera[0], camera[1]
         view, projection = np.array(camera[2]).reshape(4, 4).T, np.array(camera[3]).reshape(4, 4).T
         clip = projection @ view @ np.array([point[0], point[1], point[2], 1.0])
-        if abs(clip[3]) > 1e-9 or time.monotonic() > deadline:
+        if np.isfinite(clip).all() and abs(clip[3]) > 1e-9:
             break
+        assert time.monotonic() < deadline, f"the window's camera was not set within 60 s: {camera[:4]}"
         time.sleep(0.05)
     x, y = clip[:2] / clip[3]
     return int(round((x + 1.0) / 2.0 * width)), int(round((1.0 - y) / 2.0 * height))

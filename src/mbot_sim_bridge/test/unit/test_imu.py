@@ -133,15 +133,16 @@ def test_bad_imu_and_p3d_tags_are_refused_with_the_tag(mbot_urdf, tmp_path):
 
 
 def test_an_unknown_sensor_warns_once_and_the_rest_works(mbot_urdf, tmp_path, caplog):
-    stereo = """<gazebo reference="base_link"><sensor type="multicamera" name="stereo"><update_rate>10</update_rate>
-        <plugin name="stereo" filename="libgazebo_ros_multicamera.so"><cameraName>stereo</cameraName></plugin>
+    prosilica = """<gazebo reference="base_link"><sensor type="camera" name="prosilica"><update_rate>10</update_rate>
+        <plugin name="prosilica" filename="libgazebo_ros_prosilica.so"><cameraName>prosilica</cameraName></plugin>
         </sensor></gazebo></robot>"""
     sim = world_simulation(tmp_path)
     try:
-        spawned = sim.spawn_robot(parse_robot(with_imu(mbot_urdf).replace("</robot>", stereo), "model 'mbot'"), "mbot")
+        urdf = with_imu(mbot_urdf).replace("</robot>", prosilica)
+        spawned = sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot")
         sim.step(100)
         warnings = [message for message in map(logging.LogRecord.getMessage, caplog.records)
-                    if "libgazebo_ros_multicamera.so" in message]
+                    if "libgazebo_ros_prosilica.so" in message]
         assert len(warnings) == 1 and "not emulated" in warnings[0]
         assert plugin_of(spawned, ImuSensor).latest is not None and plugin_of(spawned, P3D).latest is not None
     finally:

@@ -19,6 +19,11 @@ EXPECTED = dict([
     ("libgazebo_ros_imu_sensor.so", ("/bot", "/", "r1")),
     ("libgazebo_ros_planar_move.so", ("/", "/", "r1")),
     ("libgazebo_ros_skid_steer_drive.so", ("/", "/", "r1")),
+    ("libgazebo_ros_tricycle_drive.so", ("bot", "bot", "r1")),
+    ("libgazebo_ros_multicamera.so", ("/", "bot", "r1")),
+    ("libgazebo_ros_block_laser.so", ("/", "/", "r1")),
+    ("libgazebo_ros_f3d.so", ("/", "/", "r1")),
+    ("libgazebo_ros_ft_sensor.so", ("/", "/", "r1")),
     # hector_gazebo_plugins (melodic-devel) and velodyne_simulator (1.0.13): NodeHandle(tag or "" / "/").
     ("libhector_gazebo_ros_imu.so", ("/", "/", "r1")),
     ("libhector_gazebo_ros_gps.so", ("/", "/", "r1")),
