@@ -27,7 +27,7 @@ WHEELS = ("left_wheel_joint", "right_wheel_joint")
 
 
 def raw_pybullet_rtf(sim_seconds: float) -> float:
-    import xacro
+    import xacro_noetic as xacro
     from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
     from mbot_sim_bridge.core.engine import Engine
     from mbot_sim_bridge.core.robot_model import parse_robot

@@ -50,7 +50,7 @@ IMU_BLOCK = """<link name="imu_link"/>
 def course_urdf(name: str) -> str:
     package_path = os.environ.get("ROS_PACKAGE_PATH", "")
     os.environ["ROS_PACKAGE_PATH"] = os.path.join(WORKSPACE, "src") + os.pathsep + package_path
-    import xacro
+    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo", name + ".xacro")
     return xacro.process_file(path).toxml()
 

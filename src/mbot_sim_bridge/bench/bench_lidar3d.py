@@ -28,7 +28,7 @@ from mbot_sim_bridge.plugins.gazebo_ros_velodyne_laser import FIELDS, POINT
 
 
 def rover_urdf(lidar: bool) -> str:
-    import xacro
+    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "rover_description", "urdf", "rover.urdf.xacro")
     return resolve_package_uris(xacro.process_file(path, mappings={"lidar_3d_enabled": str(lidar).lower()}).toxml())
 

@@ -25,7 +25,7 @@ BOXES = 5000
 
 
 def raw_robots_rtf(robots: int, sim_seconds: float) -> float:
-    import xacro
+    import xacro_noetic as xacro
     from mbot_sim_bridge.core.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
     from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS

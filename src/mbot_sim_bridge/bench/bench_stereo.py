@@ -24,7 +24,7 @@ from mbot_sim_bridge.core.simulation import Simulation
 
 
 def spawn():
-    import xacro
+    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "mobile_test_robots", "urdf", "stereo_head.urdf.xacro")
     sim = Simulation(parse_world(PLAY_GROUND), CORE_PLUGINS)
     urdf = xacro.process_file(path, mappings={}).toxml()

@@ -211,7 +211,7 @@ def core_logs_to(path: str):
 def camera_frame(world_path: str, x: float, y: float, yaw: float, log_path: str):
     """What the course's kinect would see from the robot's final pose: one frame of the same camera code the
     simulator runs (core/camera.py), rendered in a world of its own, without ROS; its logs go to ``log_path``."""
-    import xacro
+    import xacro_noetic as xacro
     from mbot_sim_bridge.core.camera import DepthCamera
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
     from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS

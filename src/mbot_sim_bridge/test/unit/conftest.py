@@ -9,7 +9,7 @@ WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".
 def expand_xacro(relative_path: str) -> str:
     """Run the real xacro on a file of mbot_description, as robot_description would hold it."""
     os.environ["ROS_PACKAGE_PATH"] = WORKSPACE_SRC + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
-    import xacro
+    import xacro_noetic as xacro
     # mappings: the xacro:arg defaults apply (xacro's Python API needs the argument map, even empty).
     return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path), mappings={}).toxml()
 

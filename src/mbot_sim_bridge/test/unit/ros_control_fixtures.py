@@ -55,7 +55,7 @@ def switch(sim, manager, start=(), stop=(), strictness=2):
 
 
 def expand_xacro_arm(interface):
-    import xacro
+    import xacro_noetic as xacro
     return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
                               mappings={"interface": interface}).toxml()
 

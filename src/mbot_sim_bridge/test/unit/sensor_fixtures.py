@@ -86,7 +86,7 @@ def course_urdf(name: str) -> str:
     """A Gazebo xacro of mbot_description expanded by the real xacro ("mbot_with_kinect_gazebo")."""
     source = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
     os.environ["ROS_PACKAGE_PATH"] = source + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
-    import xacro
+    import xacro_noetic as xacro
     return xacro.process_file(os.path.join(source, "mbot_description", "urdf", "gazebo", name + ".xacro")).toxml()
 
 

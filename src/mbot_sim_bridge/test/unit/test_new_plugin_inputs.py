@@ -7,7 +7,7 @@ import re
 import warnings
 
 import pytest
-import xacro
+import xacro_noetic as xacro
 from sensor_fixtures import box, world_simulation
 from test_bumper import LUMPED, ROBOT as BUMPER_ROBOT
 from test_hector import BOX as HECTOR_ROBOT

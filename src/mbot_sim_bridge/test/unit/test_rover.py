@@ -4,7 +4,7 @@ own control.yaml, as its launch files do."""
 import os
 
 import pytest
-import xacro
+import xacro_noetic as xacro
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, measured_motion, simulate, start_controllers
 
 from mbot_sim_bridge.package_uris import resolve_package_uris

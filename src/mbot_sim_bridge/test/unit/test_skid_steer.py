@@ -4,7 +4,7 @@ import math
 import os
 
 import pytest
-import xacro
+import xacro_noetic as xacro
 from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError

@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 import pytest
-import xacro
+import xacro_noetic as xacro
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose
