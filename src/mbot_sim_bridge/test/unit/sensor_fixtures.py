@@ -1,7 +1,9 @@
 """Shared builders for the sensor tests: the core plugin registry, worlds with a wall or a box, and the
 course's mbot with an IMU, p3d and their sensors added the way a Gazebo user writes them."""
+import math
 import os
 
+from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
@@ -33,6 +35,21 @@ def world_simulation(tmp_path, *models, seed=0) -> Simulation:
     with open(path, "w") as world:
         world.write(_WORLD.format(models="\n  ".join(models)))
     return Simulation(parse_world(path), CORE_PLUGINS, seed=seed)
+
+
+def drive_motion(sim, spawned, plugin, linear, angular, settle, window=1.0):
+    """A drive plugin's command (``set_command(linear, angular)``) held for ``settle`` s, then the robot's mean
+    forward speed in its own frame and its heading change per second over ``window`` s (ground truth)."""
+    plugin.set_command(linear, angular)
+    sim.step(int(settle * 1000))
+    speeds, heading0, start = [], yaw(spawned.robot.root_pose().orientation), sim.sim_time
+    for _ in range(int(window * 20)):
+        sim.step(50)
+        velocity, _ = spawned.robot.root_velocity()
+        heading = yaw(spawned.robot.root_pose().orientation)
+        speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
+    turned = math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi)
+    return sum(speeds) / len(speeds), turned / (sim.sim_time - start)
 
 
 def plugin_of(spawned, plugin_class):

@@ -5,10 +5,9 @@ import os
 
 import pytest
 import xacro_noetic as xacro
-from sensor_fixtures import plugin_of, world_simulation
+from sensor_fixtures import drive_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.skid_steer_drive import SkidSteerDrive
 
@@ -29,23 +28,9 @@ def base(tmp_path_factory):
     sim.close()
 
 
-def motion(sim, spawned, plugin, linear, angular, settle=1.0, window=1.0):
-    """Mean forward speed in the robot frame and heading change per second over ``window``, after ``settle``."""
-    plugin.set_command(linear, angular)
-    sim.step(int(settle * 1000))
-    speeds, heading0, start = [], yaw(spawned.robot.root_pose().orientation), sim.sim_time
-    for _ in range(int(window * 20)):
-        sim.step(50)
-        velocity, _ = spawned.robot.root_velocity()
-        heading = yaw(spawned.robot.root_pose().orientation)
-        speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
-    turned = math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi)
-    return sum(speeds) / len(speeds), turned / (sim.sim_time - start)
-
-
 @pytest.mark.parametrize("linear", [0.5, -0.3])
 def test_straight_lines_within_5_percent(base, linear):
-    speed, yaw_rate = motion(*base, linear, 0.0)
+    speed, yaw_rate = drive_motion(*base, linear, 0.0, settle=1.0)
     print(f"figure: skid steer plugin: {linear} m/s commanded -> {speed:.4f} m/s")
     assert speed == pytest.approx(linear, rel=0.05)
     assert abs(yaw_rate) < 0.01
@@ -54,7 +39,7 @@ def test_straight_lines_within_5_percent(base, linear):
 @pytest.mark.parametrize("angular", [0.8, -0.8])
 def test_turns_in_place_the_commanded_way(base, angular):
     """Skid steering turns by sliding the wheels sideways: the rate depends on friction (README)."""
-    speed, yaw_rate = motion(*base, 0.0, angular)
+    speed, yaw_rate = drive_motion(*base, 0.0, angular, settle=1.0)
     print(f"figure: skid steer plugin: {angular} rad/s commanded -> {yaw_rate:.3f} rad/s")
     assert yaw_rate * angular > 0 and abs(yaw_rate) > 0.3 * abs(angular)
     assert abs(speed) < 0.02
@@ -62,7 +47,7 @@ def test_turns_in_place_the_commanded_way(base, angular):
 
 def test_odometry_is_the_ground_truth_and_nan_is_ignored_and_reset_stops(base):
     sim, spawned, plugin = base
-    motion(sim, spawned, plugin, 0.4, 0.0, settle=0.5, window=0.2)
+    drive_motion(sim, spawned, plugin, 0.4, 0.0, settle=0.5, window=0.2)
     sim.step(10)  # one update at 100 Hz
     assert plugin.latest.pose.position == pytest.approx(spawned.robot.root_pose().position, abs=0.01)
     assert plugin.latest.linear[0] == pytest.approx(0.4, rel=0.05)

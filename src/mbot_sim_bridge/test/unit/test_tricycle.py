@@ -7,7 +7,7 @@ import os
 
 import pytest
 import xacro_noetic as xacro
-from sensor_fixtures import plugin_of, world_simulation
+from sensor_fixtures import drive_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
@@ -38,24 +38,10 @@ def tricycle(tmp_path_factory):
     sim.close()
 
 
-def motion(sim, spawned, plugin, speed, angle, settle=1.5, window=1.0):
-    """Mean forward speed of the rear axle (base_footprint) in its own frame and the yaw rate, over ``window``."""
-    plugin.set_command(speed, angle)
-    sim.step(int(settle * 1000))
-    speeds, heading0, start = [], yaw(spawned.robot.root_pose().orientation), sim.sim_time
-    for _ in range(int(window * 20)):
-        sim.step(50)
-        velocity, _ = spawned.robot.root_velocity()
-        heading = yaw(spawned.robot.root_pose().orientation)
-        speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
-    turned = math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi)
-    return sum(speeds) / len(speeds), turned / (sim.sim_time - start)
-
-
 @pytest.mark.parametrize("speed, angle", [(0.5, 0.0), (-0.3, 0.0), (0.5, 0.4), (0.5, -0.4), (-0.3, 0.4)])
 def test_the_base_moves_as_a_tricycle_within_5_percent(tricycle, speed, angle):
     sim, spawned, plugin = tricycle
-    forward, yaw_rate = motion(sim, spawned, plugin, speed, angle)
+    forward, yaw_rate = drive_motion(sim, spawned, plugin, speed, angle, settle=1.5)
     # The front wheel rolls at `speed` along its own heading; the rear axle follows.
     expected_forward, expected_yaw_rate = speed * math.cos(angle), speed * math.sin(angle) / WHEELBASE
     (steering, _, _), = spawned.robot.joint_state(["front_steering_joint"])
@@ -68,7 +54,7 @@ def test_the_base_moves_as_a_tricycle_within_5_percent(tricycle, speed, angle):
 
 def test_world_odometry_is_the_ground_truth(tricycle):
     sim, spawned, plugin = tricycle
-    motion(sim, spawned, plugin, 0.4, 0.2, settle=1.0, window=0.2)
+    drive_motion(sim, spawned, plugin, 0.4, 0.2, settle=1.0, window=0.2)
     sim.step(20)  # one update at 50 Hz
     odometry = plugin.latest
     assert odometry.pose.position == pytest.approx(spawned.robot.root_pose().position, abs=0.01)

@@ -12,7 +12,6 @@ from typing import Tuple
 
 from . import names
 from .clock import UpdateTimer
-from .errors import ConfigError
 from .geometry import Pose, yaw
 from .params import Param, non_negative
 from .plugin import Plugin
@@ -173,20 +172,14 @@ class DiffDrive(TwistCommand, Plugin):
 
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
-        robot = context.robot
         self.params = params = self.read_params()
         self.namespace = self.robot_namespace()
-        for tag in ("leftJoint", "rightJoint"):
-            if params[tag] not in robot.joint_index:
-                movable = ", ".join(robot.movable_joints) or "none"
-                raise ConfigError(f"{context.where(element)}: {self.label}: <{tag}> names joint '{params[tag]}', which "
-                                  f"the robot does not have; movable joints: {movable}")
+        self.joints = self.named_joints(params, ("leftJoint", "rightJoint"))
         level = _LOG_LEVELS.get(params["rosDebugLevel"].lower())
         if level is not None:
             # Gazebo sets the whole server's roscpp level from this tag; the bridge sets its own loggers'
             # level, leaving rospy's internals (which log broken pipes at DEBUG) at their default.
             logging.getLogger("rosout.mbot_sim_bridge").setLevel(level)
-        self.joints = (params["leftJoint"], params["rightJoint"])
         self.driven_joints = self.joints
         if params["publishWheelJointState"]:
             self.joint_states_published = self.joints

@@ -13,6 +13,7 @@ import numpy as np
 
 from .clock import UpdateTimer
 from .names import plugin_namespace
+from .errors import ConfigError
 from .params import Param, PluginParams
 
 if TYPE_CHECKING:  # imported for the annotations only: the Simulation imports this module
@@ -100,6 +101,16 @@ class Plugin:
         element = self.element if element is None else element
         reader = PluginParams(element, self.label, self.IGNORED_TAGS, self.context.where(element), check_unknown)
         return reader.read(self.PARAMS if params is None else params)
+
+    def named_joints(self, params: Dict[str, Any], tags: Sequence[str]) -> Tuple[str, ...]:
+        """The joints the tags name; one the robot lacks refuses the spawn, listing the movable joints."""
+        robot = self.context.robot
+        for tag in tags:
+            if params[tag] not in robot.joint_index:
+                movable = ", ".join(robot.movable_joints) or "none"
+                raise ConfigError(f"{self.context.where(self.element)}: {self.label}: <{tag}> names joint "
+                                  f"'{params[tag]}', which the robot does not have; movable joints: {movable}")
+        return tuple(params[tag] for tag in tags)
 
     def on_step(self, step_size: float):
         """After every physics step, when ``needs_every_step``."""

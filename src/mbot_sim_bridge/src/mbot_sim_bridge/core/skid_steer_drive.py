@@ -12,7 +12,6 @@ from typing import NamedTuple, Optional, Tuple
 from . import names
 from .clock import UpdateTimer
 from .diff_drive import TwistCommand, yaw_rotated_velocity
-from .errors import ConfigError
 from .geometry import Pose, yaw
 from .params import Param, non_negative, positive
 from .plugin import Plugin
@@ -53,13 +52,7 @@ class SkidSteerDrive(TwistCommand, Plugin):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         self.params = params = self.read_params()
-        robot = context.robot
-        for tag in WHEEL_TAGS:
-            if params[tag] not in robot.joint_index:
-                movable = ", ".join(robot.movable_joints) or "none"
-                raise ConfigError(f"{context.where(element)}: {self.label}: <{tag}> names joint '{params[tag]}', which "
-                                  f"the robot does not have; movable joints: {movable}")
-        self.joints = tuple(params[tag] for tag in WHEEL_TAGS)
+        self.joints = self.named_joints(params, WHEEL_TAGS)
         self.driven_joints = self.joints
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
         self.latest: Optional[SkidSteerOdometry] = None

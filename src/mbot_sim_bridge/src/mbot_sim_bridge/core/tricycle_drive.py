@@ -23,7 +23,6 @@ from typing import NamedTuple, Optional, Tuple
 from . import names
 from .clock import UpdateTimer
 from .diff_drive import TwistCommand, yaw_rotated_velocity
-from .errors import ConfigError
 from .geometry import Pose, pose_from_xyz_rpy, yaw
 from .params import Param, non_negative, positive
 from .plugin import Plugin
@@ -75,13 +74,7 @@ class TricycleDrive(TwistCommand, Plugin):
         self.params = params = self.read_params()
         if params["wheelDeceleration"] is None:
             params["wheelDeceleration"] = params["wheelAcceleration"]
-        robot = context.robot
-        for tag in JOINT_TAGS:
-            if params[tag] not in robot.joint_index:
-                movable = ", ".join(robot.movable_joints) or "none"
-                raise ConfigError(f"{context.where(element)}: {self.label}: <{tag}> names joint '{params[tag]}', which "
-                                  f"the robot does not have; movable joints: {movable}")
-        self.joints = tuple(params[tag] for tag in JOINT_TAGS)
+        self.joints = self.named_joints(params, JOINT_TAGS)
         self.steering_joint, self.wheel_joint = self.joints[:2]
         self.driven_joints = self.joints[:2]
         if params["publishWheelJointState"]:

@@ -5,8 +5,8 @@ from geometry_msgs.msg import WrenchStamped
 
 from ..core.ft_sensor import FTSensor
 from ..core.names import resolve_frame, tf_prefix
-from . import RosPlugin, resolve_in_namespace, ros_time
-from .messages import set_xyz
+from . import RosPlugin, resolve_in_namespace
+from .messages import set_wrench_stamped
 
 
 class GazeboRosFT(RosPlugin, FTSensor):
@@ -26,7 +26,5 @@ class GazeboRosFT(RosPlugin, FTSensor):
         if not self.topics.listened(self.publisher):
             return
         super().update(now)
-        self.message.header.stamp = ros_time(now)
-        set_xyz(self.message.wrench.force, self.latest.force)
-        set_xyz(self.message.wrench.torque, self.latest.torque)
+        set_wrench_stamped(self.message, now, self.latest.force, self.latest.torque)
         self.publisher.publish(self.message)
