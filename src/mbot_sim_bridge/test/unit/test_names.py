@@ -33,6 +33,9 @@ EXPECTED = dict([
     ("libgazebo_ros_range.so", ("/", "/", "r1")),
     ("libgazebo_ros_bumper.so", ("/", "/", "r1")),
     ("libhector_gazebo_ros_sonar.so", ("/", "/", "r1")),
+    # roboticsgroup_upatras_gazebo_plugins: NodeHandle(tag or "").
+    ("libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so", ("/", "/", "r1")),
+    ("libroboticsgroup_gazebo_mimic_joint_plugin.so", ("/", "/", "r1")),
 ])
 
 

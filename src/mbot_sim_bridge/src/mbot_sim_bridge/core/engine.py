@@ -162,10 +162,11 @@ class SpawnedRobot:
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.VELOCITY_CONTROL,
                                           targetVelocity=velocity, force=max_force)
 
-    def set_joint_position(self, joint_name: str, position: float, max_force: float):
-        """A position servo reaching ``position`` with at most ``max_force`` (N·m or N)."""
+    def set_joint_position(self, joint_name: str, position: float, max_force: float, velocity: float = 0.0):
+        """A position servo reaching ``position`` with at most ``max_force`` (N·m or N); ``velocity``, the
+        target's own speed, keeps a servo following a moving target from lagging behind it."""
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.POSITION_CONTROL,
-                                          targetPosition=position, force=max_force)
+                                          targetPosition=position, targetVelocity=velocity, force=max_force)
 
     def set_joint_effort(self, joint_name: str, effort: float):
         """A torque (or force) for the next physics step only (PyBullet's TORQUE_CONTROL); it acts only once

@@ -12,7 +12,8 @@ MODEL      the model name                the model name         diff_drive, join
 SENSOR     the simulator's ("/")         the model name         laser, camera, multicamera, openni_kinect
 ROOT       "/"                           "/"                    imu (the model plugin), p3d, f3d, ft_sensor,
                                                                 planar_move, skid_steer, range, bumper, hector
-                                                                imu, gps, magnetic and sonar, velodyne, block_laser
+                                                                imu, gps, magnetic and sonar, velodyne, block_laser,
+                                                                roboticsgroup mimic_joint
 IMU_SENSOR "/" + the model name          "/"                    imu_sensor
 ========== ============================= ====================== ==============================================
 """

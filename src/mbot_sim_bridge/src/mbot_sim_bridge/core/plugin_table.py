@@ -18,6 +18,7 @@ from .hector_magnetic import HectorMagnetic
 from .imu import ImuModelPlugin, ImuSensor
 from .joint_states import JointStatePublisher
 from .lidar import RaySensor
+from .mimic_joint import MIMIC_PLUGIN, MimicJoint
 from .multicamera import MultiCamera
 from .p3d import P3D
 from .planar_move import PlanarMove
@@ -53,6 +54,9 @@ CORE_PLUGINS: Dict[str, type] = {
     "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
     "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,
     "libgazebo_ros_block_laser.so": BlockLaser,
+    MIMIC_PLUGIN: MimicJoint,
+    # The same plugin under the package's name before 2020.
+    "libroboticsgroup_gazebo_mimic_joint_plugin.so": MimicJoint,
 }
 
 

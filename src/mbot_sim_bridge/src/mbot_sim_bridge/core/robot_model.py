@@ -83,6 +83,7 @@ class Joint:
     velocity: float = 0.0
     has_limit: bool = False  # a <limit> element was given
     has_safety_controller: bool = False
+    mimic: Optional[Tuple[str, float, float]] = None  # <mimic>: (leader joint, multiplier, offset)
 
     @property
     def movable(self) -> bool:
@@ -157,6 +158,18 @@ def _parse_document(urdf_xml: str, source: str) -> XmlDocument:
     return document
 
 
+def _mimic(element: ElementTree.Element, where: str, document: XmlDocument) -> Optional[Tuple[str, float, float]]:
+    """URDF <mimic joint= multiplier= offset=> (multiplier 1 and offset 0 when absent), or None."""
+    mimic = element.find("mimic")
+    if mimic is None:
+        return None
+    if not mimic.get("joint"):
+        raise ModelError(f"{where}: <mimic> needs a joint")
+    multiplier = read_attribute_numbers(mimic, "multiplier", document, (1.0,), 1)[0]
+    offset = read_attribute_numbers(mimic, "offset", document, (0.0,), 1)[0]
+    return mimic.get("joint"), multiplier, offset
+
+
 def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDocument) -> dict:
     limit = element.find("limit")
     if limit is None:
@@ -224,8 +237,14 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
                                    read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
                                    if axis is not None else (1.0, 0.0, 0.0),
                                    has_safety_controller=element.find("safety_controller") is not None,
+                                   mimic=_mimic(element, where, document),
                                    **_joint_limits(element, joint_type, document))
 
+    for joint in joints.values():
+        if joint.mimic is not None and (joint.mimic[0] not in joints or not joints[joint.mimic[0]].movable
+                                        or not joint.movable):
+            raise ModelError(f"{source} joint '{joint.name}': <mimic joint='{joint.mimic[0]}'> needs a movable joint "
+                             f"mimicking a movable joint of the robot")
     children = {joint.child for joint in joints.values()}
     roots = [link_name for link_name in links if link_name not in children]
     if len(roots) != 1:

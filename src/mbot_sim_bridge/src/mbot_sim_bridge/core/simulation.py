@@ -21,6 +21,7 @@ from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
 from .joint_states import JointStatePublisher
 from .log import get_logger, warn_once
+from .mimic_joint import MIMIC_PLUGIN, MimicJoint
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext
 from .plugin_table import filename_of
@@ -251,6 +252,14 @@ class Simulation:
                                    "no ROS plugin; nothing is published for it")
             for element in elements:
                 plugins.extend(self._create_plugin(spawned, element, sensor, link_name))
+        mimicked = {plugin.follower for plugin in plugins if isinstance(plugin, MimicJoint)}
+        for joint in model.joints.values():
+            if joint.mimic is not None and joint.name not in mimicked:
+                leader, multiplier, offset = joint.mimic
+                element = MimicJoint.plugin_element(MIMIC_PLUGIN, f"{joint.name}_mimic", joint=leader,
+                                                    mimicJoint=joint.name, multiplier=repr(multiplier),
+                                                    offset=repr(offset))
+                plugins.extend(self._create_plugin(spawned, element, None, None))
         published = {joint for plugin in plugins for joint in plugin.joint_states_published}
         remaining = [joint for joint in spawned.robot.movable_joints if joint not in published]
         if remaining:
