@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """Two-joint arms reach position setpoints within a degree through ros_control: /effort_arm with
 effort_controllers/JointPositionController (PID to effort), /position_arm with
-position_controllers/JointGroupPositionController. Joint angles come from each arm's joint_state_controller."""
+position_controllers/JointGroupPositionController. Joint angles come from each arm's joint_state_controller; the
+PID controllers' control_msgs/JointControllerState follows their setpoint and joint at a tenth of the control rate."""
 import math
 import unittest
 
 import rospy
 import rostest
+from control_msgs.msg import JointControllerState
 from controller_manager_msgs.srv import ListControllers
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
@@ -63,6 +65,23 @@ class RosControlArms(unittest.TestCase):
             errors = self.reach("effort_arm", setpoint)
             self.figures.append(f"effort arm (effort_controllers/JointPositionController) at {setpoint} rad: errors "
                                 f"{errors[0]:.3f}, {errors[1]:.3f} degrees")
+
+    def test_pid_controller_state_follows_the_setpoint(self):
+        states = []
+        subscriber = rospy.Subscriber("/effort_arm/elbow_position_controller/state", JointControllerState,
+                                      states.append)
+        wait_for(lambda: len(states) >= 20, what="twenty elbow controller states")
+        subscriber.unregister()
+        state = states[-1]
+        stamps = [message.header.stamp.to_sec() for message in states[-10:]]
+        period = (stamps[-1] - stamps[0]) / 9
+        positions = dict(zip(self.states["effort_arm"].name, self.states["effort_arm"].position))
+        self.figures.append(f"elbow controller state: set point {state.set_point:.3f}, process value "
+                            f"{state.process_value:.3f}, every {period * 1000:.1f} ms, p {state.p:g}")
+        self.assertAlmostEqual(state.process_value, positions["elbow"], delta=0.05)
+        self.assertAlmostEqual(state.error, state.set_point - state.process_value, delta=1e-9)
+        self.assertAlmostEqual(period, 10 * state.time_step, delta=1e-6)  # every tenth control update
+        self.assertGreater(state.p, 0.0)
 
     def test_non_finite_commands_on_the_topics_are_ignored(self):
         """NaN and inf on the command topics leave both arms where they were; 1e308 is taken as the joint limit."""

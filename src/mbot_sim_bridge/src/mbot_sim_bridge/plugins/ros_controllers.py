@@ -1,12 +1,13 @@
 """The ROS side of the ros_controllers (``core/controllers.py``): their topics, under the controller's namespace
 (``<robot namespace>/<controller name>``) as upstream's controller NodeHandle puts them.
 
-Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock. The controllers' state
-topics (control_msgs/JointControllerState) are not published: Debian does not package control_msgs.
+Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock. The single-joint PID
+controllers publish control_msgs/JointControllerState on ``state`` every tenth update, as upstream.
 """
 import math
 
 import rospy
+from control_msgs.msg import JointControllerState
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
@@ -16,13 +17,10 @@ from tf2_msgs.msg import TFMessage
 from ..core.ros_control import CORE_CONTROLLERS
 from ..core.ros_control.diff_drive_controller import DiffDriveController
 from ..core.ros_control.joint_state_controller import JointStateController
-from ..core.log import get_logger, warn_once
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame
 from . import loop_publisher, resolve_in_namespace
 from .messages import diagonal_covariance
-
-_logger = get_logger(__name__)
 
 
 class RosJointStateController(JointStateController):
@@ -109,9 +107,8 @@ class _CommandTopic:
     """A ``command`` subscriber: Float64 for single-joint controllers, Float64MultiArray for groups."""
 
     def _subscribe(self, namespace, group):
-        if hasattr(self, "pid"):
-            warn_once(_logger, f"{self.name}: the 'state' topic (control_msgs/JointControllerState) is not published: "
-                               "Debian does not package control_msgs")
+        self.state_publisher = (loop_publisher(namespace + "/state", JointControllerState)
+                                if hasattr(self, "state_sample") else None)
         message_type = Float64MultiArray if group else Float64
         self.subscriber = TrackedSubscriber(namespace + "/command", message_type, self._on_command)
 
@@ -124,10 +121,15 @@ class _CommandTopic:
             rospy.logerr(complaint)
 
     def publish(self, stamp):
-        pass
+        message = JointControllerState(**self.state_sample._asdict())
+        message.header.stamp = stamp
+        self.state_sample = None
+        self.state_publisher.publish(message)
 
     def close(self):
         self.subscriber.unregister()
+        if self.state_publisher is not None:
+            self.state_publisher.unregister()
 
 
 def _ros_class(core_class: type) -> type:

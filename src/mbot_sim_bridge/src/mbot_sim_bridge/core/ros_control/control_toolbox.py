@@ -43,8 +43,8 @@ class Pid:
         if "i_clamp_max" in params:
             i_max = abs(float(params["i_clamp_max"]))
         if params.get("publish_state"):
-            warn_once(_logger, f"{namespace}/publish_state: the PID state topic needs control_msgs, which Debian does "
-                               "not package; not published")
+            warn_once(_logger, f"{namespace}/publish_state: the PID's own control_msgs/PidState topic is not "
+                               "published (the controllers' JointControllerState is)")
         return cls(float(params["p"]), float(params.get("i", 0.0)), float(params.get("d", 0.0)), i_max, i_min,
                    bool(params.get("antiwindup", False)))
 

@@ -177,8 +177,8 @@ class DiffDriveController(Controller):
         self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
         self.publish_cmd = get("publish_cmd", False, bool)
         if get("publish_wheel_joint_controller_state", False, bool):
-            warn_once(_logger, f"{name}: publish_wheel_joint_controller_state needs control_msgs, which Debian does "
-                               "not package; not published")
+            warn_once(_logger, f"{name}: publish_wheel_joint_controller_state is not supported; the wheels' "
+                               "JointTrajectoryControllerState is not published")
         self.wheel_separation = get("wheel_separation", None)
         self.wheel_radius = get("wheel_radius", None)
         self._geometry_from_urdf(context.urdf, left[0], right[0])

@@ -1,6 +1,9 @@
 """The PID controllers of effort_controllers and velocity_controllers: JointPositionController,
-JointVelocityController, JointGroupPositionController (control_toolbox's Pid from ``pid/p i d i_clamp``)."""
-from typing import Optional
+JointVelocityController, JointGroupPositionController (control_toolbox's Pid from ``pid/p i d i_clamp``).
+
+The single-joint ones take a sample of their state every tenth update, the first included, as upstream fills
+its control_msgs/JointControllerState (``state``) then; the ROS layer publishes it."""
+from typing import NamedTuple, Optional
 
 from ..robot_model import RobotModel
 from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
@@ -47,7 +50,39 @@ def _pid(params: dict, key: str, namespace: str) -> Pid:
     return pid
 
 
-class PidPositionController(Controller):
+STATE_EVERY_UPDATES = 10
+
+
+class StateSample(NamedTuple):
+    """control_msgs/JointControllerState's values."""
+    set_point: float
+    process_value: float
+    process_value_dot: float
+    error: float
+    time_step: float
+    command: float
+    p: float
+    i: float
+    d: float
+    i_clamp: float
+    antiwindup: bool
+
+
+class _StateSampling:
+    """Mixed into a single-joint PID controller: ``state_sample`` every STATE_EVERY_UPDATES updates."""
+
+    def _sample(self, set_point: float, process_value: float, period: float):
+        if self.updates % STATE_EVERY_UPDATES == 0:
+            pid = self.pid
+            self.state_sample = StateSample(set_point, process_value, self.joint.velocity, self.error, period,
+                                            self.output, pid.p, pid.i, pid.d, pid.i_max, pid.antiwindup)
+        self.updates += 1
+
+    def publish_due(self, now):
+        return self.state_sample is not None
+
+
+class PidPositionController(_StateSampling, Controller):
     """effort_controllers/JointPositionController (INTERFACE EFFORT) and velocity_controllers/
     JointPositionController (INTERFACE VELOCITY): PID on the position error, output as the joint's command."""
 
@@ -61,6 +96,7 @@ class PidPositionController(Controller):
         self.target = 0.0
         self.target_velocity = None
         self.error = self.output = 0.0
+        self.updates, self.state_sample = 0, None
 
     def set_command(self, position: float, velocity: Optional[float] = None):
         if self.finite_command([self.joint.name] * 2, [position, 0.0 if velocity is None else velocity]):
@@ -76,9 +112,10 @@ class PidPositionController(Controller):
         velocity_error = None if self.target_velocity is None else self.target_velocity - self.joint.velocity
         self.output = self.pid.compute(self.error, period, velocity_error)
         self.joint.command = self.output
+        self._sample(target, self.joint.position, period)
 
 
-class EffortVelocityController(Controller):
+class EffortVelocityController(_StateSampling, Controller):
     """effort_controllers/JointVelocityController: PID on the velocity error, output as effort."""
 
     INTERFACE = EFFORT
@@ -90,6 +127,7 @@ class EffortVelocityController(Controller):
         self.pid = _pid(params, "pid", self.namespace)
         self.target = 0.0
         self.error = self.output = 0.0
+        self.updates, self.state_sample = 0, None
 
     def set_command(self, velocity: float):
         if self.finite_command([self.joint.name], [velocity]):
@@ -103,6 +141,7 @@ class EffortVelocityController(Controller):
         self.error = self.target - self.joint.velocity
         self.output = self.pid.compute(self.error, period)
         self.joint.command = self.output
+        self._sample(self.target, self.joint.velocity, period)
 
 
 class EffortGroupPositionController(ForwardJointGroupCommandController):
