@@ -318,3 +318,33 @@ def test_pid_gains_turn_position_joints_into_pid_driven_effort_joints(legacy):
         assert max(math.degrees(abs(a - b)) for a, b in zip(reached, (0.7, -0.4))) < 1.0
     finally:
         sim.close()
+
+
+SOFT_UPPER = 1.0
+SAFETY = f'<safety_controller soft_lower_limit="-1.0" soft_upper_limit="{SOFT_UPPER}" k_position="20" k_velocity="50"/>'
+
+
+@pytest.mark.parametrize("interface, controller", [("Position", "shoulder_controller"),
+                                                   ("Effort", "shoulder_position_controller")])
+def test_a_joint_commanded_past_its_soft_limit_stops_at_it(interface, controller):
+    """joint_limits_interface's soft limits from <safety_controller>: the shoulder (hard limit 2.0 rad) is
+    commanded to 1.9 rad and stops at its soft upper limit of 1.0 (the effort one short of it by what holding
+    the arm up against gravity takes, 1/(k_position k_velocity) rad per N·m)."""
+    urdf = expand_xacro_arm(interface).replace('<joint name="shoulder" type="revolute">',
+                                               f'<joint name="shoulder" type="revolute">{SAFETY}', 1)
+    sim, spawned, plugin = simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", f"arm_{interface.lower()}.yaml")),
+                                    "arm")
+    try:
+        assert plugin.hw.joints["shoulder"].soft_limits is not None
+        start_controllers(sim, plugin, controller).set_command(1.9)
+        highest = 0.0
+        for _ in range(30):
+            sim.step(100)
+            highest = max(highest, spawned.robot.joint_state(["shoulder"])[0][0])
+        final = spawned.robot.joint_state(["shoulder"])[0][0]
+        print(f"figure: soft limit {SOFT_UPPER} rad ({interface.lower()} interface), commanded 1.9: the shoulder "
+              f"stops at {final:.4f} rad (highest {highest:.4f})")
+        assert highest < SOFT_UPPER + 0.005
+        assert final == pytest.approx(SOFT_UPPER, abs=0.005 if interface == "Position" else 0.05)
+    finally:
+        sim.close()

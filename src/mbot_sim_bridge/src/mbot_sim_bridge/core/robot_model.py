@@ -82,7 +82,8 @@ class Joint:
     effort: float = 0.0
     velocity: float = 0.0
     has_limit: bool = False  # a <limit> element was given
-    has_safety_controller: bool = False
+    # <safety_controller>: (soft_lower_limit, soft_upper_limit, k_position, k_velocity)
+    safety: Optional[Tuple[float, float, float, float]] = None
     mimic: Optional[Tuple[str, float, float]] = None  # <mimic>: (leader joint, multiplier, offset)
 
     @property
@@ -156,6 +157,18 @@ def _parse_document(urdf_xml: str, source: str) -> XmlDocument:
     if document.root.tag != "robot":
         raise ModelError(f"{source} is not URDF: its root element is <{document.root.tag}>, not <robot>")
     return document
+
+
+def _safety_controller(element: ElementTree.Element, where: str,
+                       document: XmlDocument) -> Optional[Tuple[float, float, float, float]]:
+    """URDF <safety_controller> (urdfdom: k_velocity required, the others 0 when absent), or None."""
+    safety = element.find("safety_controller")
+    if safety is None:
+        return None
+    if safety.get("k_velocity") is None:
+        raise ModelError(f"{where}: <safety_controller> needs k_velocity")
+    return tuple(read_attribute_numbers(safety, name, document, (0.0,), 1)[0]
+                 for name in ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"))
 
 
 def _mimic(element: ElementTree.Element, where: str, document: XmlDocument) -> Optional[Tuple[str, float, float]]:
@@ -236,7 +249,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
                                    read_origin(element, document),
                                    read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
                                    if axis is not None else (1.0, 0.0, 0.0),
-                                   has_safety_controller=element.find("safety_controller") is not None,
+                                   safety=_safety_controller(element, where, document),
                                    mimic=_mimic(element, where, document),
                                    **_joint_limits(element, joint_type, document))
 

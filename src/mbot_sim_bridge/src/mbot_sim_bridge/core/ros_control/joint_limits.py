@@ -1,5 +1,5 @@
 """joint_limits_interface: limits from the URDF joint (``RobotModel``, read and checked there) and from the
-``joint_limits/<joint>`` parameters, which override them."""
+``joint_limits/<joint>`` parameters, which override them; soft limits from the URDF's <safety_controller>."""
 import math
 from dataclasses import dataclass
 from typing import Optional
@@ -25,6 +25,20 @@ class JointLimits:
     has_effort_limits: bool = False
     max_effort: float = 0.0
     angle_wraparound: bool = False
+
+
+@dataclass
+class SoftJointLimits:
+    """joint_limits_interface::SoftJointLimits."""
+    min_position: float
+    max_position: float
+    k_position: float
+    k_velocity: float
+
+
+def urdf_soft_joint_limits(joint: Optional[Joint]) -> Optional[SoftJointLimits]:
+    """joint_limits_interface::getSoftJointLimits(urdf joint): None without a <safety_controller>."""
+    return SoftJointLimits(*joint.safety) if joint is not None and joint.safety is not None else None
 
 
 def urdf_joint_limits(joint: Optional[Joint]) -> Optional[JointLimits]:

@@ -3,6 +3,7 @@ the constructor, ``read_sim``, ``write_sim``), by ``<robotSimType>`` in ``ROBOT_
 
 DefaultRobotHWSim: one joint per transmission with its first hardware interface; joint limits
 from the URDF and the ``joint_limits/<joint>`` parameters, enforced as joint_limits_interface's saturation
+handles, or as its soft-limits handles when the URDF joint has a <safety_controller>
 handles; ``gazebo_ros_control/pid_gains/<joint>`` turns position and velocity joints into PID-driven effort
 joints; the e-stop."""
 import math
@@ -16,7 +17,8 @@ from .angles import shortest_angular_distance, shortest_angular_distance_with_li
 from .control_toolbox import Pid, clamp
 from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,
                                  UNBOUNDED_EFFORT, VELOCITY, HardwareInterfaceError)
-from .joint_limits import JointLimits, apply_limit_params, urdf_joint_limits
+from .joint_limits import (JointLimits, SoftJointLimits, apply_limit_params, urdf_joint_limits,
+                           urdf_soft_joint_limits)
 from .transmissions import Transmission
 
 _logger = get_logger(__name__)
@@ -32,6 +34,7 @@ class SimJoint:
     joint_type: str  # URDF type, or inferred from the limits; "" if unknown
     limits: Optional[JointLimits]
     pid: Optional[Pid] = None
+    soft_limits: Optional[SoftJointLimits] = None
     # gazebo_ros_control starts these at 1.0 (position, effort) until the first read.
     position: float = 1.0
     velocity: float = 0.0
@@ -108,10 +111,9 @@ class DefaultRobotHWSim:
             if not joint_type and limits is not None:
                 joint_type = ("revolute" if limits.has_position_limits
                               else "continuous" if limits.angle_wraparound else "prismatic")
-            if urdf_joint is not None and urdf_joint.has_safety_controller:
-                warn_once(_logger, f"{label}: joint '{joint_name}' has a <safety_controller>: soft joint limits are "
-                                   "not simulated; its hard limits are enforced as saturation")
-            self._check_limits(joint_name, interface, limits)
+            # As upstream, soft limits apply only to a joint with limits.
+            soft_limits = urdf_soft_joint_limits(urdf_joint) if limits is not None else None
+            self._check_limits(joint_name, interface, limits, soft_limits)
             pid = None
             if interface != EFFORT:
                 # Upstream logs "No p gain specified" as an error for every joint without gains; that is the
@@ -123,14 +125,17 @@ class DefaultRobotHWSim:
                     why = ("its PID gains are refused" if isinstance(gains, dict) and "p" in gains
                            else f"no {pid_namespace}/{joint_name}/p")
                     info_once(_logger, f"{label}: {why}: joint '{joint_name}' is driven directly ({drive})")
-            self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid)
+            self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid, soft_limits)
         self.names = list(self.joints)
 
-    def _check_limits(self, joint: str, interface: str, limits: Optional[JointLimits]):
-        """The saturation handles' constructors refuse limits they cannot enforce (JointLimitsInterfaceException)."""
+    def _check_limits(self, joint: str, interface: str, limits: Optional[JointLimits],
+                      soft_limits: Optional[SoftJointLimits]):
+        """The limit handles' constructors refuse limits they cannot enforce (JointLimitsInterfaceException); the
+        soft velocity handle needs none, the soft position handle needs velocity limits."""
         if limits is None:
             return
-        if interface in (EFFORT, VELOCITY) and not limits.has_velocity_limits:
+        needs_velocity = (EFFORT, POSITION) if soft_limits is not None else (EFFORT, VELOCITY)
+        if interface in needs_velocity and not limits.has_velocity_limits:
             raise ConfigError(f"{self.label}: Cannot enforce limits for joint '{joint}'. It has no "
                               "velocity limits specification.")
         if interface == EFFORT and not limits.has_effort_limits:
@@ -176,6 +181,9 @@ class DefaultRobotHWSim:
             self._drive(joint, period)
 
     def _saturate(self, joint: SimJoint, period: float):
+        if joint.soft_limits is not None:
+            self._soft_saturate(joint, period)
+            return
         limits = joint.limits
         if joint.interface == EFFORT:
             low, high = -limits.max_effort, limits.max_effort
@@ -206,6 +214,38 @@ class DefaultRobotHWSim:
                 high = min(joint.previous_velocity_command + step, high)
             joint.command = clamp(joint.command, low, high)
             joint.previous_velocity_command = joint.command
+
+    def _soft_saturate(self, joint: SimJoint, period: float):
+        """joint_limits_interface's soft-limits handles: the allowed velocity shrinks towards each soft limit at
+        k_position per unit of distance (within the velocity limit), and an effort is bounded by k_velocity times
+        how far the joint's velocity is from that allowed one (within the effort limit)."""
+        limits, soft = joint.limits, joint.soft_limits
+        max_velocity = limits.max_velocity if limits.has_velocity_limits else math.inf
+        position = joint.position
+        if joint.interface == POSITION:
+            if math.isnan(joint.previous_command):
+                joint.previous_command = joint.position
+            position = joint.previous_command  # upstream bounds each step from the last command
+        if limits.has_position_limits:
+            low_velocity = clamp(-soft.k_position * (position - soft.min_position), -max_velocity, max_velocity)
+            high_velocity = clamp(-soft.k_position * (position - soft.max_position), -max_velocity, max_velocity)
+        else:
+            low_velocity, high_velocity = -max_velocity, max_velocity
+        if joint.interface == EFFORT:
+            low = clamp(-soft.k_velocity * (joint.velocity - low_velocity), -limits.max_effort, limits.max_effort)
+            high = clamp(-soft.k_velocity * (joint.velocity - high_velocity), -limits.max_effort, limits.max_effort)
+        elif joint.interface == POSITION:
+            low, high = position + low_velocity * period, position + high_velocity * period
+            if limits.has_position_limits:
+                low, high = max(low, limits.min_position), min(high, limits.max_position)
+        else:
+            low, high = low_velocity, high_velocity
+            if limits.has_acceleration_limits:
+                low = max(joint.velocity - limits.max_acceleration * period, low)
+                high = min(joint.velocity + limits.max_acceleration * period, high)
+        joint.command = clamp(joint.command, low, high)
+        if joint.interface == POSITION:
+            joint.previous_command = joint.command
 
     def _drive(self, joint: SimJoint, period: float):
         e_stop = self.e_stop_active
