@@ -1,6 +1,7 @@
 """NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
-hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne): each value is refused with one line, or runs without an
-exception, and a robot two metres away does not move by 1 mm."""
+tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d, mimic
+joints): each value is refused with one line, or runs without an exception, and a robot two metres away does not
+move by 1 mm."""
 import math
 import os
 import re
@@ -11,9 +12,12 @@ import xacro_noetic as xacro
 from sensor_fixtures import box, world_simulation
 from test_bumper import LUMPED, ROBOT as BUMPER_ROBOT
 from test_hector import BOX as HECTOR_ROBOT
+from test_mimic_joint import GRIPPER, PLUGIN as MIMIC_PLUGIN_BLOCK
+from test_multicamera import HEAD as STEREO_XACRO
 from test_planar_move import BASE as HOLONOMIC_XACRO
 from test_range import HECTOR_PLUGIN, RANGE_PLUGIN, ROBOT as SONAR_ROBOT, SONAR
 from test_skid_steer import BASE as SKID_XACRO
+from test_tricycle import TRICYCLE as TRICYCLE_XACRO
 from test_velodyne import ROBOTS, STAND
 
 from mbot_sim_bridge.core.errors import BridgeError
@@ -122,4 +126,62 @@ def test_sensor_tags(tmp_path, robot, tag, text):
         for filename in HECTOR_FILES:
             urdf = urdf.replace(f'filename="{filename}">', f'filename="{filename}"><{tag}>{value}</{tag}>')
     moved = run(tmp_path, urdf)
+    assert moved is None or moved < 1e-3
+
+
+@pytest.fixture(scope="module")
+def tricycle():
+    return xacro.process_file(TRICYCLE_XACRO, mappings={"odometry_source": "encoder"}).toxml()
+
+
+@pytest.mark.parametrize("value", BAD_VALUES)
+@pytest.mark.parametrize("axis", [0, 1])
+def test_tricycle_commands(tmp_path, tricycle, axis, value):
+    command = [0.3, 0.2]
+    command[axis] = value
+    assert run(tmp_path, tricycle, lambda plugin: plugin.set_command(*command)) < 1e-3
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("tag", ["actuatedWheelDiameter", "encoderWheelDiameter", "encoderWheelSeparation",
+                                 "wheelTorque", "updateRate", "wheelAcceleration", "wheelSpeedTolerance",
+                                 "steeringSpeed", "steeringAngleTolerance", "gaussianNoise", "samples", "min", "max"])
+def test_tricycle_and_block_laser_tags(tmp_path, tricycle, tag, text):
+    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", tricycle)
+    moved = run(tmp_path, urdf, lambda plugin: plugin.set_command(0.3, 0.2))
+    assert moved is None or moved < 1e-3
+
+
+@pytest.fixture(scope="module")
+def stereo_head():
+    return xacro.process_file(STEREO_XACRO, mappings={"rate": "50"}).toxml()
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("tag", ["horizontal_fov", "width", "near", "far", "hackBaseline", "updateRate",
+                                 "gaussianNoise", "pose"])
+def test_stereo_head_tags(tmp_path, stereo_head, tag, text):
+    """The multicamera's, the ft sensor's (gaussianNoise, updateRate) and the f3d's inputs."""
+    value = " ".join([text] * 6) if tag == "pose" else text
+    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{value}</{tag}>", stereo_head)
+    moved = run(tmp_path, urdf)
+    assert moved is None or moved < 1e-3
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("tag", ["multiplier", "offset", "sensitiveness", "maxEffort"])
+def test_mimic_tags(tmp_path, tag, text):
+    plugin = MIMIC_PLUGIN_BLOCK.format(extra=f"<hasPID/><{tag}>{text}</{tag}>" if tag == "maxEffort"
+                                       else f"<{tag}>{text}</{tag}>")
+    urdf = GRIPPER.format(mimic="", plugin=plugin.replace("<multiplier>-1</multiplier>", "")
+                          .replace("<offset>0.002</offset>", "") if tag in ("multiplier", "offset") else plugin)
+    moved = run(tmp_path, urdf)
+    assert moved is None or moved < 1e-3
+
+
+@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("attribute", ["multiplier", "offset"])
+def test_urdf_mimic_attributes(tmp_path, attribute, text):
+    mimic = f'<mimic joint="left_finger_joint" {attribute}="{text}"/>'
+    moved = run(tmp_path, GRIPPER.format(mimic=mimic, plugin=""))
     assert moved is None or moved < 1e-3

@@ -95,7 +95,8 @@ class BlockLaser(RaySensor):
             intensity += self.noise_rng.normal(0.0, noise, len(ranges))
             hit = np.abs(config.range_max - ranges) > _AT_RANGE_MAX
             xyz[hit] += position_noise[hit]
-        return BlockCloud(xyz.astype(np.float32), intensity.astype(np.float32))
+        with np.errstate(over="ignore"):  # Point32 is float32: beyond its range a coordinate is ±inf, as in C++
+            return BlockCloud(xyz.astype(np.float32), intensity.astype(np.float32))
 
     def update(self, now: float):
         self.latest = self.cloud()

@@ -54,7 +54,8 @@ CAMERA_SENSOR_PARAMS = (
     Param("camera/image/width", int, 320, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
     Param("camera/image/height", int, 240, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
     Param("camera/image/format", str, "R8G8B8", "pixel format", warn_if_missing=False),
-    positive("camera/clip/near", float, 0.1, "m", warn_if_missing=False),
+    # PyBullet's TinyRenderer never returns from a frame whose near plane is under about 1e-10 m.
+    Param("camera/clip/near", float, 0.1, "m", minimum=1e-6, warn_if_missing=False),
     positive("camera/clip/far", float, 100.0, "m", warn_if_missing=False),
     Param("camera/noise/type", str, "none", "gaussian or none", warn_if_missing=False),
     Param("camera/noise/mean", float, 0.0, "in [0, 1] colour units", warn_if_missing=False),

@@ -8,8 +8,9 @@ gets N(0, ``gaussianNoise``); ``updateRate`` 0 publishes every physics step.
 PyBullet's joint reaction sensor gives the force but, for the torque, only its part along the joint's axis, so
 the wrench is computed from the child's side instead, by Newton–Euler over the child link and every link below
 it: F = Σ m(a − g) − the contact forces and applied wrenches on them, M about the joint likewise with
-I·α + ω × I·ω, accelerations from the velocity change over the last step. A fixed joint is lumped away, as
-Gazebo lumps it, so a sensor on one is refused as Gazebo's "does not exist".
+I·α + ω × I·ω, accelerations from the velocity change since the previous reading (zero for the first one, and
+for the first after a reset or after nobody listened, while the bridge looks only every 50 ms). A fixed joint is
+lumped away, as Gazebo lumps it, so a sensor on one is refused as Gazebo's "does not exist".
 """
 from typing import List, NamedTuple, Optional, Tuple
 
@@ -18,6 +19,7 @@ import numpy as np
 from . import names
 from .clock import UpdateTimer
 from .errors import ConfigError
+from .imu import IDLE_PERIOD
 from .geometry import rotation_matrix
 from .params import ERROR_MODEL_LIMIT, Param, non_negative
 from .plugin import Plugin
@@ -43,7 +45,6 @@ class FTSensor(Plugin):
         non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
     )
     IGNORED_TAGS = ("alwaysOn",)
-    needs_every_step = True
 
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
@@ -68,8 +69,9 @@ class FTSensor(Plugin):
         self.gravity = np.asarray(context.simulation.engine.physics.gravity, dtype=float)
         self.rng = context.random_stream(element.get("name") or "ft_sensor")
         self.timer = UpdateTimer(self.params["updateRate"], start=context.simulation.sim_time)
-        self._previous: Optional[Tuple[np.ndarray, np.ndarray]] = None
-        self._accelerations = (np.zeros((len(self.links), 3)), np.zeros((len(self.links), 3)))
+        self.period = self.timer.period
+        # (sim time, linear and angular velocities of the child side's links) at the previous reading.
+        self._previous: Optional[Tuple[float, np.ndarray, np.ndarray]] = None
         self.latest: Optional[JointWrench] = None
 
     def _below(self, index: int, parents) -> bool:
@@ -84,26 +86,27 @@ class FTSensor(Plugin):
         return robot.client.getLinkStates(robot.body, self.links, computeLinkVelocity=1,
                                           computeForwardKinematics=1)
 
-    def on_step(self, step_size: float):
-        states = self._states()
-        velocities = (np.array([state[6] for state in states]), np.array([state[7] for state in states]))
-        if self._previous is not None:
-            self._accelerations = tuple((now - before) / step_size for now, before in zip(velocities,
-                                                                                          self._previous))
-        self._previous = velocities
+    def idle(self, now: float):
+        """While nobody listens, look only every IDLE_PERIOD; the next reading starts its accelerations afresh."""
+        self.timer.period = max(self.period, IDLE_PERIOD)
+        self._previous = None
 
     def reset(self, now: float):
         super().reset(now)
         self._previous = None
-        self._accelerations = tuple(np.zeros_like(value) for value in self._accelerations)
 
-    def wrench(self) -> Tuple[np.ndarray, np.ndarray]:
+    def wrench(self, now: float) -> Tuple[np.ndarray, np.ndarray]:
         """(force, torque about the joint) the joint applies to the child side, world frame."""
         robot = self.context.robot
         states = self._states()
         centres = np.array([state[0] for state in states])
-        linear, angular = self._accelerations
-        omegas = np.array([state[7] for state in states])
+        velocities = np.array([state[6] for state in states]), np.array([state[7] for state in states])
+        linear, angular = np.zeros_like(centres), np.zeros_like(centres)
+        if self._previous is not None and now > self._previous[0]:
+            elapsed = now - self._previous[0]
+            linear, angular = ((current - before) / elapsed for current, before in zip(velocities, self._previous[1:]))
+        self._previous = (now, *velocities)
+        omegas = velocities[1]
         joint_origin = np.asarray(robot.link_world_pose(self.child_link).position)
         inertial = self.masses[:, np.newaxis] * (linear - self.gravity)
         force = inertial.sum(axis=0)
@@ -146,7 +149,8 @@ class FTSensor(Plugin):
         return applied
 
     def update(self, now: float):
-        force, torque = self.wrench()
+        self.timer.period = self.period
+        force, torque = self.wrench(now)
         rotation = np.asarray(rotation_matrix(self.context.robot.link_world_pose(self.child_link).orientation))
         # Gazebo's body2Force and body2Torque: negated, in the child link's frame.
         values = np.concatenate([rotation.T @ -force, rotation.T @ -torque])

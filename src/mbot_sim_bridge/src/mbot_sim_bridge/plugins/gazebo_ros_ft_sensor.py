@@ -24,6 +24,7 @@ class GazeboRosFT(RosPlugin, FTSensor):
 
     def update(self, now: float):
         if not self.topics.listened(self.publisher):
+            self.idle(now)
             return
         super().update(now)
         set_wrench_stamped(self.message, now, self.latest.force, self.latest.torque)
