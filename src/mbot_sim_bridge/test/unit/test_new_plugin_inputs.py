@@ -27,6 +27,9 @@ from mbot_sim_bridge.core.robot_model import parse_robot
 VLP16_MACRO = os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro"))
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
 BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-300")
+# For the tags of the later plugins: one of each kind (the parser refuses nan and inf alike; the sign of a huge
+# value is read the same way), so the suite stays within its time.
+TAG_TEXTS = ("nan", "-inf", "1e308", "1e-300")
 BYSTANDER = """<robot name="crate"><link name="crate"><inertial><mass value="1"/>
   <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
   <collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link></robot>"""
@@ -142,7 +145,7 @@ def test_tricycle_commands(tmp_path, tricycle, axis, value):
     assert run(tmp_path, tricycle, lambda plugin: plugin.set_command(*command)) < 1e-3
 
 
-@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("text", TAG_TEXTS)
 @pytest.mark.parametrize("tag", ["actuatedWheelDiameter", "encoderWheelDiameter", "encoderWheelSeparation",
                                  "wheelTorque", "updateRate", "wheelAcceleration", "wheelSpeedTolerance",
                                  "steeringSpeed", "steeringAngleTolerance", "gaussianNoise", "samples", "min", "max"])
@@ -157,7 +160,7 @@ def stereo_head():
     return xacro.process_file(STEREO_XACRO, mappings={"rate": "50"}).toxml()
 
 
-@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("text", TAG_TEXTS)
 @pytest.mark.parametrize("tag", ["horizontal_fov", "width", "near", "far", "hackBaseline", "updateRate",
                                  "gaussianNoise", "pose"])
 def test_stereo_head_tags(tmp_path, stereo_head, tag, text):
@@ -168,7 +171,7 @@ def test_stereo_head_tags(tmp_path, stereo_head, tag, text):
     assert moved is None or moved < 1e-3
 
 
-@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("text", TAG_TEXTS)
 @pytest.mark.parametrize("tag", ["multiplier", "offset", "sensitiveness", "maxEffort"])
 def test_mimic_tags(tmp_path, tag, text):
     plugin = MIMIC_PLUGIN_BLOCK.format(extra=f"<hasPID/><{tag}>{text}</{tag}>" if tag == "maxEffort"
@@ -179,7 +182,7 @@ def test_mimic_tags(tmp_path, tag, text):
     assert moved is None or moved < 1e-3
 
 
-@pytest.mark.parametrize("text", BAD_TEXTS)
+@pytest.mark.parametrize("text", TAG_TEXTS)
 @pytest.mark.parametrize("attribute", ["multiplier", "offset"])
 def test_urdf_mimic_attributes(tmp_path, attribute, text):
     mimic = f'<mimic joint="left_finger_joint" {attribute}="{text}"/>'
