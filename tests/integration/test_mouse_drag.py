@@ -38,9 +38,11 @@ def insert(simulation, tmp_path, database_name, name, x, y):
     simulation.add_world(parse_world(str(path)))
 
 
-def window_pixel(client, point):
+def window_pixel(simulation, point):
     """Where a world point appears in the window, from its camera's view and projection matrices (read again until
-    the window has applied the camera: before that they are zero)."""
+    the window reports its camera: PyBullet answers zeros until then, at times for long on a loaded machine; the
+    simulation keeps stepping meanwhile)."""
+    client = simulation.engine.client
     deadline = time.monotonic() + 60.0
     while True:
         camera = client.getDebugVisualizerCamera()
@@ -50,6 +52,7 @@ def window_pixel(client, point):
         if np.isfinite(clip).all() and abs(clip[3]) > 1e-9:
             break
         assert time.monotonic() < deadline, f"the window's camera was not set within 60 s: {camera[:4]}"
+        simulation.step(1)
         time.sleep(0.05)
     x, y = clip[:2] / clip[3]
     return int(round((x + 1.0) / 2.0 * width)), int(round((1.0 - y) / 2.0 * height))
@@ -98,11 +101,10 @@ def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulati
     insert(simulation, tmp_path, "unit_box", "unit_box", 0.0, 0.0)
     insert(simulation, tmp_path, "cafe_table", "cafe_table", -1.5, -1.0)
     simulation.step(300)
-    client = simulation.engine.client
     box_start = simulation.engine.model_pose("unit_box").position
     table_start = simulation.engine.model_pose("cafe_table")
-    drags = [(window_pixel(client, (-1.5, -1.0, 0.755)), window_pixel(client, (-1.5, 1.0, 0.755))),  # the table
-             (window_pixel(client, (0.0, 0.0, 1.0)), window_pixel(client, (*DRAG_TO, 1.0)))]  # the box's top
+    drags = [(window_pixel(simulation, (-1.5, -1.0, 0.755)), window_pixel(simulation, (-1.5, 1.0, 0.755))),  # the table
+             (window_pixel(simulation, (0.0, 0.0, 1.0)), window_pixel(simulation, (*DRAG_TO, 1.0)))]  # the box's top
 
     def mouse_work():
         for start, end in drags:

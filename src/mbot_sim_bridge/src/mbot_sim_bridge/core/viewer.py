@@ -57,7 +57,8 @@ class Viewer:
         self._last_follow = now
         if now > self._camera_settled_at:
             camera = self.engine.client.getDebugVisualizerCamera()
-            self._camera = (camera[10], camera[8], camera[9])
+            if camera[0] > 0:  # a window that has not reported its camera yet answers zeros (distance 0)
+                self._camera = (camera[10], camera[8], camera[9])
         self._aim(self.followed)
 
     def _aim(self, robot: SpawnedRobot):
