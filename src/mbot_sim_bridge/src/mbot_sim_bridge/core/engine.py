@@ -374,7 +374,7 @@ class Engine:
                      | pybullet.URDF_USE_IMPLICIT_CYLINDER)
             # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
             with open(os.devnull, "w") as devnull, c_stdout_to(devnull):
-                body = self.client.loadURDF(path, flags=flags)
+                body = self.client.loadURDF(path, flags=flags, useFixedBase=model.anchored)
         except pybullet.error as error:
             raise ModelError(f"PyBullet could not load model '{model.name}': {error}") from None
         finally:

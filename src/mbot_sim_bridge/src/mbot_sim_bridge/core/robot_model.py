@@ -104,6 +104,12 @@ class RobotModel:
     transmissions: List[ElementTree.Element]
     document: XmlDocument  # the parsed robot_description: line numbers for messages
 
+    @property
+    def anchored(self) -> bool:
+        """Whether the root link is URDF's ``world``: Gazebo fixes the model to the world there, as arm
+        descriptions mount their base with a fixed ``world_joint``."""
+        return self.root == "world"
+
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
 

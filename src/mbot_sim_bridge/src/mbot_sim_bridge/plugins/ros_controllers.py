@@ -2,21 +2,32 @@
 (``<robot namespace>/<controller name>``) as upstream's controller NodeHandle puts them.
 
 Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock. The single-joint PID
-controllers publish control_msgs/JointControllerState on ``state`` every tenth update, as upstream.
+controllers publish control_msgs/JointControllerState on ``state`` every tenth update, as upstream. The
+trajectory and gripper controllers serve their actions with actionlib's ActionServer: a goal's outcome found by
+the update goes out with the next publish, one decided in a ROS callback (preemption, cancel) at once.
 """
 import math
 
+import actionlib
 import rospy
-from control_msgs.msg import JointControllerState
+from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectoryFeedback, FollowJointTrajectoryResult,
+                              GripperCommandAction, GripperCommandResult, JointControllerState,
+                              JointTrajectoryControllerState)
+from control_msgs.srv import QueryTrajectoryState, QueryTrajectoryStateResponse
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from ..core.ros_control import CORE_CONTROLLERS
 from ..core.ros_control.diff_drive_controller import DiffDriveController
+from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
+from ..core.ros_control.joint_trajectory_controller import (ABORTED, SUCCEEDED, JointTolerance, JointTrajectory,
+                                                            JointTrajectoryController, TrajectoryGoal,
+                                                            TrajectoryPoint)
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame
 from . import loop_publisher, resolve_in_namespace
@@ -132,6 +143,156 @@ class _CommandTopic:
             self.state_publisher.unregister()
 
 
+def _trajectory(message: JointTrajectoryMessage) -> JointTrajectory:
+    return JointTrajectory(list(message.joint_names), [
+        TrajectoryPoint(list(point.positions), list(point.velocities), list(point.accelerations),
+                        point.time_from_start.to_sec()) for point in message.points], message.header.stamp.to_sec())
+
+
+def _tolerances(tolerances) -> list:
+    return [JointTolerance(tolerance.name, tolerance.position, tolerance.velocity, tolerance.acceleration)
+            for tolerance in tolerances]
+
+
+class _ActionController:
+    """The action side shared by the trajectory and gripper controllers: an actionlib ActionServer on
+    ``<controller>/<action>`` whose goals' outcomes (the core's ``ended``) are sent by ``_send_ended``."""
+
+    def _serve(self, namespace: str, action: str, action_type):
+        self.server = actionlib.ActionServer(namespace + "/" + action, action_type, self._on_goal, self._on_cancel,
+                                             auto_start=False)
+        self.server.start()
+
+    def _send_ended(self):
+        with self.lock:
+            ended, self.ended = self.ended, []
+        for end in ended:
+            handle = end.goal.handle
+            if end.status == SUCCEEDED:
+                handle.set_succeeded(self._result(end))
+            elif end.status == ABORTED:
+                handle.set_aborted(self._result(end))
+            else:
+                handle.set_canceled()
+
+    def _on_cancel(self, handle):
+        with self.lock:
+            active = self.active_goal
+            if active is not None and active.handle == handle:
+                self.cancel_goal(active)
+        self._send_ended()
+
+    def stopping(self, now):
+        super().stopping(now)
+        self._send_ended()
+
+    def close(self):
+        self.server.stop()
+
+
+class RosJointTrajectoryController(_ActionController, JointTrajectoryController):
+    """``command`` (trajectory_msgs/JointTrajectory), ``state`` (control_msgs/JointTrajectoryControllerState),
+    ``query_state`` and the ``follow_joint_trajectory`` action, with feedback at action_monitor_rate."""
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        namespace = context.namespace
+        self.state_publisher = loop_publisher(namespace + "/state", JointTrajectoryControllerState)
+        self.subscriber = TrackedSubscriber(namespace + "/command", JointTrajectoryMessage, self._on_command)
+        self.query_service = rospy.Service(namespace + "/query_state", QueryTrajectoryState, self._on_query)
+        self._last_feedback = -math.inf
+        self._serve(namespace, "follow_joint_trajectory", FollowJointTrajectoryAction)
+
+    def _on_command(self, message):
+        self.command(_trajectory(message))
+        self._send_ended()
+
+    def _on_goal(self, handle):
+        goal = handle.get_goal()
+        accepted, error_code, error_string = self.accept_goal(TrajectoryGoal(
+            _trajectory(goal.trajectory), _tolerances(goal.path_tolerance), _tolerances(goal.goal_tolerance),
+            goal.goal_time_tolerance.to_sec(), handle))
+        if not accepted:
+            handle.set_rejected(FollowJointTrajectoryResult(error_code=error_code, error_string=error_string))
+            return
+        self._send_ended()  # the goal it preempted, first
+        handle.set_accepted()
+
+    @staticmethod
+    def _result(end):
+        return FollowJointTrajectoryResult(error_code=end.error_code, error_string=end.error_string)
+
+    def _on_query(self, request):
+        sampled = self.query_state(request.time.to_sec())
+        if sampled is None:
+            raise rospy.ServiceException("the trajectory cannot be sampled at that time (see the simulator's log)")
+        return QueryTrajectoryStateResponse(list(self.joint_names), *sampled)
+
+    def _fill(self, message, stamp):
+        """The header and the desired, actual and error points of a state or feedback message."""
+        message.header.stamp = stamp
+        message.joint_names = list(self.joint_names)
+        desired_from_start, actual_from_start, error_from_start = self.times_from_start
+        message.desired.positions, message.desired.velocities, message.desired.accelerations = self.desired
+        message.desired.time_from_start = rospy.Duration.from_sec(desired_from_start)
+        message.actual.positions, message.actual.velocities = self.actual
+        message.actual.time_from_start = rospy.Duration.from_sec(actual_from_start)
+        message.error.positions, message.error.velocities = self.error[:2]
+        message.error.time_from_start = rospy.Duration.from_sec(error_from_start)
+        return message
+
+    def publish(self, stamp):
+        self._send_ended()
+        with self.lock:
+            state = self._fill(JointTrajectoryControllerState(), stamp) if self.state_due else None
+            self.state_due = False
+            active = self.active_goal
+            feedback = None
+            if (active is not None and self.action_monitor_period > 0.0
+                    and self.time - self._last_feedback >= self.action_monitor_period - 1e-9):
+                self._last_feedback = self.time
+                feedback = self._fill(FollowJointTrajectoryFeedback(), stamp)
+        if state is not None:
+            self.state_publisher.publish(state)
+        if feedback is not None:
+            active.handle.publish_feedback(feedback)
+
+    def restart_clock(self, now):
+        super().restart_clock(now)
+        self._last_feedback = -math.inf
+
+    def close(self):
+        super().close()
+        self.subscriber.unregister()
+        self.state_publisher.unregister()
+        self.query_service.shutdown()
+
+
+class RosGripperActionController(_ActionController, GripperActionController):
+    """The ``gripper_cmd`` action (control_msgs/GripperCommand)."""
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        self._serve(context.namespace, "gripper_cmd", GripperCommandAction)
+
+    def _on_goal(self, handle):
+        command = handle.get_goal().command
+        goal = GripperGoal(command.position, command.max_effort, handle)
+        if not self.accept_goal(goal):
+            handle.set_rejected(GripperCommandResult())
+            return
+        self._send_ended()
+        handle.set_accepted()
+
+    @staticmethod
+    def _result(end):
+        return GripperCommandResult(position=end.position, effort=end.effort, stalled=end.stalled,
+                                    reached_goal=end.reached_goal)
+
+    def publish(self, stamp):
+        self._send_ended()
+
+
 def _ros_class(core_class: type) -> type:
     """The ROS class of a command controller: the core class plus its ``command`` subscriber."""
     def __init__(self, name, hw, params, context):
@@ -140,8 +301,17 @@ def _ros_class(core_class: type) -> type:
     return type("Ros" + core_class.__name__, (_CommandTopic, core_class), {"__init__": __init__})
 
 
-ROS_CONTROLLERS = {
-    controller_type: {JointStateController: RosJointStateController,
-                      DiffDriveController: RosDiffDriveController}.get(core_class) or _ros_class(core_class)
-    for controller_type, core_class in CORE_CONTROLLERS.items()
-}
+def _ros_controller(core_class: type) -> type:
+    for core_base, ros_class in ((JointStateController, RosJointStateController),
+                                 (DiffDriveController, RosDiffDriveController),
+                                 (JointTrajectoryController, RosJointTrajectoryController),
+                                 (GripperActionController, RosGripperActionController)):
+        if core_class is core_base:
+            return ros_class
+        if issubclass(core_class, core_base):  # a per-interface core class: its INTERFACE under the ROS class
+            return type("Ros" + core_class.__name__, (ros_class, core_class), {})
+    return _ros_class(core_class)
+
+
+ROS_CONTROLLERS = {controller_type: _ros_controller(core_class)
+                   for controller_type, core_class in CORE_CONTROLLERS.items()}

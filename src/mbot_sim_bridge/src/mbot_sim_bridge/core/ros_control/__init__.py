@@ -7,14 +7,17 @@ adds services and topics.
 - ``robot_hw_sim``: the robot hardware simulation (DefaultRobotHWSim); ``controller_manager``;
 - the controllers, a module per package: ``controller_interface`` (the base), ``joint_state_controller``,
   ``diff_drive_controller``, ``forward_command_controller`` (position_/velocity_/effort_controllers' forward
-  ones), ``pid_controllers`` (their PID ones). Adding a controller is a module and a line in ``CORE_CONTROLLERS``.
+  ones), ``pid_controllers`` (their PID ones), ``joint_trajectory_controller``, ``gripper_action_controller``.
+  Adding a controller is a module and a line in ``CORE_CONTROLLERS``.
 """
 from typing import Dict
 
 from .diff_drive_controller import DiffDriveController
+from .gripper_action_controller import GripperActionController
 from .forward_command_controller import ForwardCommandController, ForwardJointGroupCommandController, forward_type
 from .hardware_interface import EFFORT, POSITION, VELOCITY
 from .joint_state_controller import JointStateController
+from .joint_trajectory_controller import JointTrajectoryController
 from .pid_controllers import EffortGroupPositionController, EffortVelocityController, PidPositionController
 
 # Controller type string -> core class. The ROS layer has the same keys with its subclasses.
@@ -39,4 +42,10 @@ CORE_CONTROLLERS: Dict[str, type] = {
         type("EffortJointPositionController", (PidPositionController,), {"INTERFACE": EFFORT}),
     "effort_controllers/JointVelocityController": EffortVelocityController,
     "effort_controllers/JointGroupPositionController": EffortGroupPositionController,
+    **{f"{kind}_controllers/JointTrajectoryController":
+       type(f"{kind.capitalize()}JointTrajectoryController", (JointTrajectoryController,), {"INTERFACE": interface})
+       for kind, interface in (("position", POSITION), ("velocity", VELOCITY), ("effort", EFFORT))},
+    **{f"{kind}_controllers/GripperActionController":
+       type(f"{kind.capitalize()}GripperActionController", (GripperActionController,), {"INTERFACE": interface})
+       for kind, interface in (("position", POSITION), ("effort", EFFORT))},
 }

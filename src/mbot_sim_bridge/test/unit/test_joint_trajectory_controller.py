@@ -1,0 +1,196 @@
+"""joint_trajectory_controller and gripper_action_controller in the simulator, without ROS: the two-joint arm
+(ros_control_test_robots) with the trajectory controller on its position or effort interface."""
+import math
+
+import pytest
+from ros_control_fixtures import expand_xacro_arm, simulate, start_controllers, switch
+
+from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
+from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
+    ABORTED, CANCELED, GOAL_TOLERANCE_VIOLATED, INVALID_GOAL, INVALID_JOINTS, PATH_TOLERANCE_VIOLATED, SUCCEEDED,
+    SUCCESSFUL, JointTolerance, JointTrajectory, Segment, TrajectoryGoal, TrajectoryPoint)
+
+JOINTS = ["shoulder", "elbow"]
+# Gains in the range published arm configurations give their effort trajectory controllers.
+EFFORT_GAINS = {"shoulder": {"p": 1000.0, "i": 50.0, "d": 30.0, "i_clamp": 5.0},
+                "elbow": {"p": 500.0, "i": 20.0, "d": 10.0, "i_clamp": 2.0}}
+
+
+def trajectory_arm(interface, **extra):
+    config = {"type": f"{interface.lower()}_controllers/JointTrajectoryController", "joints": JOINTS,
+              "constraints": {"goal_time": 0.5, "stopped_velocity_tolerance": 0.05,
+                              "shoulder": {"goal": 0.01}, "elbow": {"goal": 0.01}}}
+    if interface == "Effort":
+        config["gains"] = EFFORT_GAINS
+    config.update(extra)
+    sim, spawned, plugin = simulate(expand_xacro_arm(interface), {"arm_controller": config}, "arm")
+    controller = start_controllers(sim, plugin, "arm_controller")
+    sim.step(100)
+    return sim, controller
+
+
+def goal(points, **tolerances):
+    return TrajectoryGoal(JointTrajectory(JOINTS, [TrajectoryPoint(p, time_from_start=t) for t, p in points]),
+                          **tolerances)
+
+
+def run_until_ended(sim, controller, seconds=10.0):
+    for _ in range(int(seconds / 0.01)):
+        sim.step(10)
+        if controller.ended:
+            return controller.ended.pop(0)
+    raise AssertionError(f"no outcome within {seconds} s")
+
+
+def test_segments_are_linear_cubic_or_quintic_by_the_derivatives_given_and_hold_outside():
+    linear = Segment(1.0, (0.0, None, None), 3.0, (2.0, None, None))
+    assert linear.sample(2.0) == pytest.approx((1.0, 1.0, 0.0))
+    cubic = Segment(0.0, (0.0, 0.0, None), 2.0, (1.0, 0.0, None))
+    assert cubic.sample(1.0) == pytest.approx((0.5, 0.75, 0.0))
+    assert cubic.sample(2.0) == pytest.approx((1.0, 0.0, -1.5))
+    quintic = Segment(0.0, (0.0, 1.0, 0.5), 1.0, (2.0, -1.0, 0.25))
+    assert quintic.sample(0.0) == pytest.approx((0.0, 1.0, 0.5))
+    assert quintic.sample(1.0) == pytest.approx((2.0, -1.0, 0.25))
+    assert quintic.sample(5.0) == pytest.approx((2.0, 0.0, 0.0))
+    assert quintic.sample(-1.0) == pytest.approx((0.0, 0.0, 0.0))
+
+
+@pytest.mark.parametrize("interface", ["Position", "Effort"])
+def test_a_two_point_goal_succeeds_with_every_joint_within_a_hundredth_of_a_radian(interface):
+    sim, controller = trajectory_arm(interface)
+    target = [0.6, -0.9]
+    accepted, code, _ = controller.accept_goal(goal([(1.0, [0.3, -0.4]), (2.0, target)]))
+    assert accepted and code == SUCCESSFUL
+    end = run_until_ended(sim, controller)
+    assert (end.status, end.error_code) == (SUCCEEDED, SUCCESSFUL)
+    errors = [abs(joint.position - value) for joint, value in zip(controller.joints, target)]
+    assert max(errors) < 0.01, errors
+
+
+def test_a_path_tolerance_the_arm_cannot_keep_aborts_the_goal():
+    sim, controller = trajectory_arm("Effort")
+    tight = [JointTolerance("shoulder", position=1e-4), JointTolerance("elbow", position=1e-4)]
+    assert controller.accept_goal(goal([(0.3, [1.5, -1.5])], path_tolerance=tight))[0]
+    end = run_until_ended(sim, controller)
+    assert (end.status, end.error_code) == (ABORTED, PATH_TOLERANCE_VIOLATED)
+    assert end.error_string.split()[1:3] == ["path", "error"]
+
+
+def test_a_goal_tolerance_missed_after_goal_time_aborts():
+    sim, controller = trajectory_arm("Effort", gains={joint: {"p": 5.0} for joint in JOINTS})
+    assert controller.accept_goal(goal([(0.5, [1.0, -1.0])], goal_time_tolerance=0.2))[0]
+    end = run_until_ended(sim, controller)
+    assert (end.status, end.error_code) == (ABORTED, GOAL_TOLERANCE_VIOLATED)
+
+
+def test_a_second_goal_preempts_the_first_and_unknown_joints_are_refused():
+    sim, controller = trajectory_arm("Position")
+    first, second = goal([(2.0, [0.5, 0.5])]), goal([(1.0, [-0.5, 0.2])])
+    assert controller.accept_goal(first)[0]
+    sim.step(200)
+    assert controller.accept_goal(second)[0]
+    assert controller.ended.pop(0).goal is first and not controller.ended
+    assert controller.accept_goal(TrajectoryGoal(JointTrajectory(["shoulder", "wrist"], [
+        TrajectoryPoint([0.0, 0.0], time_from_start=1.0)]))) == (False, INVALID_JOINTS, "")
+    refused = controller.accept_goal(goal([(1.0, [0.0, 0.0]), (1.0, [0.1, 0.1])]))
+    assert refused[:2] == (False, INVALID_GOAL) and "strictly increasing" in refused[2]
+    assert controller.accept_goal(goal([(1.0, [math.nan, 0.0])]))[:2] == (False, INVALID_GOAL)
+    end = run_until_ended(sim, controller)
+    assert end.goal is second and end.status == SUCCEEDED
+
+
+def test_the_command_topic_moves_the_arm_and_cancels_an_active_goal():
+    sim, controller = trajectory_arm("Position")
+    active = goal([(3.0, [1.0, 1.0])])
+    controller.accept_goal(active)
+    ok, _ = controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([-0.4, 0.7], time_from_start=0.5)]))
+    assert ok and controller.ended.pop(0).status == CANCELED
+    sim.step(1000)
+    assert [joint.position for joint in controller.joints] == pytest.approx([-0.4, 0.7], abs=0.01)
+
+
+def test_a_trajectory_starting_later_is_spliced_and_query_state_samples_it():
+    sim, controller = trajectory_arm("Position")
+    controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([1.0, 0.0], time_from_start=2.0)]))
+    sim.step(500)
+    now = sim.sim_time
+    old_at_half = controller.query_state(now + 0.5)
+    assert old_at_half[1][0] == pytest.approx(0.5, rel=0.01)  # 1 rad in 2 s, linearly
+    # The new trajectory starts 1 s from now: until then the old one runs on, a bridge joins the two.
+    later = JointTrajectory(JOINTS, [TrajectoryPoint([0.0, 0.5], time_from_start=0.5)], start=now + 1.0)
+    assert controller.command(later)[0]
+    assert controller.query_state(now + 0.5) == old_at_half
+    assert controller.query_state(now + 1.5)[0] == pytest.approx([0.0, 0.5])
+    assert controller.query_state(now - 10.0) is None  # before the trajectory's start
+    sim.step(2000)
+    assert [joint.position for joint in controller.joints] == pytest.approx([0.0, 0.5], abs=0.01)
+
+
+def test_points_in_the_past_are_dropped():
+    sim, controller = trajectory_arm("Position")
+    past = JointTrajectory(JOINTS, [TrajectoryPoint([0.2, 0.2], time_from_start=0.1)], start=sim.sim_time - 1.0)
+    ok, error = controller.command(past)
+    assert not ok and error.startswith("Dropping all 1 trajectory point(s)")
+
+
+def test_cancel_holds_and_stop_trajectory_duration_stops_smoothly():
+    sim, controller = trajectory_arm("Position", stop_trajectory_duration=0.5)
+    active = goal([(2.0, [1.5, 0.0])])
+    controller.accept_goal(active)
+    sim.step(1000)
+    moving = controller.desired[1][0]
+    assert moving > 0.5
+    controller.cancel_goal(active)
+    assert controller.ended.pop(0).status == CANCELED
+    sim.step(250)
+    assert 0.0 < controller.desired[1][0] < moving
+    sim.step(500)
+    assert controller.desired[1][0] == 0.0
+    assert controller.joints[0].position < 1.2
+
+
+def test_an_effort_trajectory_controller_without_gains_does_not_load(caplog):
+    urdf = expand_xacro_arm("Effort")
+    sim, _, plugin = simulate(urdf, {"arm_controller": {"type": "effort_controllers/JointTrajectoryController",
+                                                        "joints": JOINTS}}, "arm")
+    assert not plugin.manager.load("arm_controller", plugin.urdf)
+    assert "No p gain specified for pid.  Namespace: /arm/arm_controller/gains/shoulder" in caplog.text
+    assert "Failed to initialize PID gains from ROS parameter server." in caplog.text
+
+
+def gripper_arm(interface, **extra):
+    config = {"type": f"{interface.lower()}_controllers/GripperActionController", "joint": "elbow",
+              "stall_timeout": 0.5, **extra}
+    sim, spawned, plugin = simulate(expand_xacro_arm(interface), {"gripper": config}, "arm")
+    return sim, start_controllers(sim, plugin, "gripper")
+
+
+def test_the_gripper_reaches_a_free_goal_and_stalls_when_its_effort_cannot_move_it():
+    sim, gripper = gripper_arm("Effort", gains={"elbow": {"p": 200.0, "d": 5.0}})
+    assert gripper.accept_goal(GripperGoal(0.8, 20.0))
+    end = run_until_ended(sim, gripper)
+    assert (end.status, end.reached_goal, end.stalled) == (SUCCEEDED, True, False)
+    assert end.position == pytest.approx(0.8, abs=0.01)
+    # 0.001 N m cannot lift the forearm: it stays short of the goal and the goal ends stalled.
+    assert gripper.accept_goal(GripperGoal(0.0, 0.001))
+    end = run_until_ended(sim, gripper)
+    assert (end.status, end.reached_goal, end.stalled) == (ABORTED, False, True)
+    assert abs(end.effort) <= 0.001
+
+
+@pytest.mark.parametrize("bad", [
+    {"joints": "shoulder"}, {"joints": [1, 2]}, {"joints": []}, {"joints": ["shoulder", "wrist"]},
+    {"state_publish_rate": 0.0}, {"action_monitor_rate": -1.0}, {"state_publish_rate": "fast"},
+    {"constraints": {"goal_time": "soon", "shoulder": {"goal": math.nan}}}, {"stop_trajectory_duration": math.inf},
+    {"gains": {"shoulder": {"p": "high"}, "elbow": {"p": 1.0}}}])
+def test_bad_parameters_refuse_the_controller_or_leave_it_working(bad):
+    config = {"type": "effort_controllers/JointTrajectoryController", "joints": JOINTS, "gains": EFFORT_GAINS,
+              **bad}
+    sim, _, plugin = simulate(expand_xacro_arm("Effort"), {"arm_controller": config}, "arm")
+    if plugin.manager.load("arm_controller", plugin.urdf):
+        controller = plugin.manager.find("arm_controller").controller
+        assert switch(sim, plugin.manager, ["arm_controller"])
+        controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([0.3, 0.3], time_from_start=0.5)]))
+        controller.cancel_goal(None)
+        sim.step(1000)
+        assert all(math.isfinite(joint.position) for joint in controller.joints)
