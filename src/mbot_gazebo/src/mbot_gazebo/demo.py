@@ -26,6 +26,7 @@ from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
+from . import arm_demo
 from .demo_plot import draw_demo
 
 WORLDS = {"play_ground": "playground.world", "playground": "playground.world", "room": "room.world",
@@ -164,8 +165,13 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="mbot demo", description=__doc__.splitlines()[0])
     parser.add_argument("--world", default="play_ground", choices=sorted(WORLDS), help="world to tour")
     parser.add_argument("--gui", action="store_true", help="show the simulator window (needs a DISPLAY)")
-    parser.add_argument("--out", default=os.path.join(os.getcwd(), "out", "demo.png"), help="picture to write")
+    parser.add_argument("--arm", action="store_true",
+                        help="instead of the tour: the arm follows a trajectory, drawn to out/arm.png")
+    parser.add_argument("--out", help="picture to write (default out/demo.png, with --arm out/arm.png)")
     args = parser.parse_args(argv)
+    args.out = args.out or os.path.join(os.getcwd(), "out", "arm.png" if args.arm else "demo.png")
+    if args.arm:
+        return arm_demo.run(args.out, args.gui)
 
     world_path = os.path.join(rospkg.RosPack().get_path("mbot_gazebo"), "worlds", WORLDS[args.world])
     model = os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",

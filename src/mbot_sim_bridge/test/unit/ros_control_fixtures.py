@@ -93,3 +93,12 @@ def measured_motion(sim, spawned, controller, linear, angular, settle=1.5, windo
     dt = sim.sim_time - start
     return (sum(forward_speeds) / len(forward_speeds),
             math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi) / dt)
+
+
+def run_until_ended(sim, controller, seconds=10.0):
+    """Step until an action controller (trajectory or gripper) has ended a goal; that outcome."""
+    for _ in range(int(seconds / 0.01)):
+        sim.step(10)
+        if controller.ended:
+            return controller.ended.pop(0)
+    raise AssertionError(f"no outcome within {seconds} s")

@@ -5,7 +5,7 @@ import os
 
 import pytest
 import xacro_noetic as xacro
-from ros_control_fixtures import WORKSPACE_SRC, load_yaml, simulate, start_controllers
+from ros_control_fixtures import WORKSPACE_SRC, load_yaml, run_until_ended, simulate, start_controllers
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.sdf_world import parse_world
@@ -26,13 +26,6 @@ def arm(interface):
     arm_controller = start_controllers(sim, plugin, "arm_controller", "joint_state_controller", "gripper_controller")
     return sim, spawned, arm_controller, plugin.manager.find("gripper_controller").controller
 
-
-def run_until_ended(sim, controller, seconds=10.0):
-    for _ in range(int(seconds / 0.01)):
-        sim.step(10)
-        if controller.ended:
-            return controller.ended.pop(0)
-    raise AssertionError(f"no outcome within {seconds} s")
 
 
 @pytest.mark.parametrize("interface", ["effort", "position"])

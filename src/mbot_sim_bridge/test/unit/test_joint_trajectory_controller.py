@@ -3,7 +3,7 @@
 import math
 
 import pytest
-from ros_control_fixtures import expand_xacro_arm, simulate, start_controllers, switch
+from ros_control_fixtures import expand_xacro_arm, run_until_ended, simulate, start_controllers, switch
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
@@ -33,13 +33,6 @@ def goal(points, **tolerances):
     return TrajectoryGoal(JointTrajectory(JOINTS, [TrajectoryPoint(p, time_from_start=t) for t, p in points]),
                           **tolerances)
 
-
-def run_until_ended(sim, controller, seconds=10.0):
-    for _ in range(int(seconds / 0.01)):
-        sim.step(10)
-        if controller.ended:
-            return controller.ended.pop(0)
-    raise AssertionError(f"no outcome within {seconds} s")
 
 
 def test_segments_are_linear_cubic_or_quintic_by_the_derivatives_given_and_hold_outside():
