@@ -22,6 +22,9 @@ def trajectory_arm(interface, **extra):
                               "shoulder": {"goal": 0.01}, "elbow": {"goal": 0.01}}}
     if interface == "Effort":
         config["gains"] = EFFORT_GAINS
+    if interface == "Velocity":  # a velocity per radian of error, plus the desired velocity fed forward
+        config["gains"] = {joint: {"p": 20.0} for joint in JOINTS}
+        config["velocity_ff"] = {joint: 1.0 for joint in JOINTS}
     config.update(extra)
     sim, spawned, plugin = simulate(expand_xacro_arm(interface), {"arm_controller": config}, "arm")
     controller = start_controllers(sim, plugin, "arm_controller")
@@ -48,7 +51,7 @@ def test_segments_are_linear_cubic_or_quintic_by_the_derivatives_given_and_hold_
     assert quintic.sample(-1.0) == pytest.approx((0.0, 0.0, 0.0))
 
 
-@pytest.mark.parametrize("interface", ["Position", "Effort"])
+@pytest.mark.parametrize("interface", ["Position", "Velocity", "Effort"])
 def test_a_two_point_goal_succeeds_with_every_joint_within_a_hundredth_of_a_radian(interface):
     sim, controller = trajectory_arm(interface)
     target = [0.6, -0.9]
