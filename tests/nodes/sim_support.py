@@ -4,6 +4,7 @@ import sys
 import time
 
 import rospy
+from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty
@@ -31,6 +32,15 @@ def print_figures(lines):
 def controller_states(list_controllers) -> dict:
     """controller name -> state, from a controller_manager/list_controllers service proxy."""
     return {state.name: state.state for state in list_controllers().controller}
+
+
+def wait_for_running_controllers(names, manager="/controller_manager"):
+    """Wait until the controller manager lists exactly ``names``, all running (the spawner has done its work)."""
+    service = manager + "/list_controllers"
+    rospy.wait_for_service(service, timeout=WALL_TIMEOUT)
+    listing = rospy.ServiceProxy(service, ListControllers)
+    wait_for(lambda: controller_states(listing) == {name: "running" for name in names},
+             what="the spawner to start " + ", ".join(names))
 
 
 def yaw_of(orientation):

@@ -16,13 +16,12 @@ from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectory
                               GripperCommand, GripperCommandAction, GripperCommandGoal, JointTolerance,
                               JointTrajectoryControllerState)
 from control_msgs.srv import QueryTrajectoryState
-from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.srv import SpawnModel
 from geometry_msgs.msg import Pose
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from sim_support import WALL_TIMEOUT, print_figures, wait_for
+from sim_support import WALL_TIMEOUT, print_figures, wait_for, wait_for_running_controllers
 
 JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
           "wrist_3_joint"]
@@ -51,10 +50,7 @@ class Arm(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("arm_test")
         cls.figures = []
-        rospy.wait_for_service("/controller_manager/list_controllers", timeout=WALL_TIMEOUT)
-        listing = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
-        wait_for(lambda: sorted(c.state for c in listing().controller) == ["running"] * 3,
-                 what="the spawner to start joint_state_controller, arm_controller and gripper_controller")
+        wait_for_running_controllers(["joint_state_controller", "arm_controller", "gripper_controller"])
         # joint_states comes in parts: the controller's joints, and the mimic finger from the simulator.
         cls.joint_positions = {}
         rospy.Subscriber("/joint_states", JointState,

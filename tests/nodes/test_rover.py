@@ -15,7 +15,6 @@ import unittest
 
 import rospy
 import rostest
-from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.msg import ContactsState
 from gazebo_msgs.srv import ApplyBodyWrench, GetModelState, SpawnModel
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
@@ -23,7 +22,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for
+from sim_support import WALL_TIMEOUT, print_figures, wait_for, wait_for_running_controllers
 
 CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
@@ -66,11 +65,7 @@ class Rover(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("rover_test")
         cls.figures = []
-        rospy.wait_for_service("/controller_manager/list_controllers", timeout=WALL_TIMEOUT)
-        list_controllers = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
-        wait_for(lambda: controller_states(list_controllers) == {"rover_joint_publisher": "running",
-                                                                  CONTROLLER: "running"},
-                 what="the spawner to start both controllers")
+        wait_for_running_controllers(["rover_joint_publisher", CONTROLLER])
         cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
         cls.imu, cls.fix = Latest("/imu/data", Imu), Latest("/navsat/fix", NavSatFix)
         cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)

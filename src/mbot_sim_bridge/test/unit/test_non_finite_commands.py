@@ -10,6 +10,9 @@ from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control import CORE_CONTROLLERS
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
+from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
+from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (JointTrajectory, JointTrajectoryController,
+                                                                          TrajectoryPoint)
 
 from conftest import expand_xacro
 from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, start_controllers
@@ -52,6 +55,14 @@ COMMANDED = {
                                                                    "shoulder": {"pid": ARM_PID},
                                                                    "elbow": {"pid": ARM_PID}}),
     "diff_drive_controller/DiffDriveController": ("mbot", load_yaml(MBOT_YAML)["mobile_base_controller"]),
+    "position_controllers/JointTrajectoryController": ("Position", {"joints": ["shoulder", "elbow"]}),
+    "velocity_controllers/JointTrajectoryController": ("Velocity", {"joints": ["shoulder", "elbow"],
+                                                                    "gains": {"shoulder": {"p": 20.0},
+                                                                              "elbow": {"p": 20.0}}}),
+    "effort_controllers/JointTrajectoryController": ("Effort", {"joints": ["shoulder", "elbow"],
+                                                                "gains": {"shoulder": ARM_PID, "elbow": ARM_PID}}),
+    "position_controllers/GripperActionController": ("Position", {"joint": "elbow"}),
+    "effort_controllers/GripperActionController": ("Effort", {"joint": "elbow", "gains": {"elbow": ARM_PID}}),
 }
 
 
@@ -63,6 +74,13 @@ def command(sim, controller, value):
     """``value`` for every joint, as the controller's command topic would carry it; the refusal, if any."""
     if isinstance(controller, DiffDriveController):
         return controller.set_command(value, value, sim.sim_time)
+    if isinstance(controller, JointTrajectoryController):
+        controller.command(JointTrajectory(controller.joint_names,
+                                           [TrajectoryPoint([value] * len(controller.joints), time_from_start=0.5)]))
+        return None
+    if isinstance(controller, GripperActionController):
+        controller.accept_goal(GripperGoal(value, 10.0))
+        return None
     if hasattr(controller, "set_commands"):
         return controller.set_commands([value] * len(controller.joints))
     return controller.set_command(value)

@@ -97,10 +97,13 @@ class GripperActionController(Controller):
             self.active_goal = None
 
     def accept_goal(self, goal: GripperGoal) -> bool:
-        """goalCB: False when the controller is not running; else the goal replaces the active one."""
+        """goalCB: False when the controller is not running or the goal is not finite numbers (upstream takes
+        those); else the goal replaces the active one."""
         with self.lock:
             if self.state != "running":
                 _logger.error(f"{self.name}: Can't accept new action goals. Controller is not running.")
+                return False
+            if not self.finite_command([self.joint.name] * 2, [goal.position, goal.max_effort]):
                 return False
             self._preempt()
             self.position, self.max_effort = goal.position, goal.max_effort

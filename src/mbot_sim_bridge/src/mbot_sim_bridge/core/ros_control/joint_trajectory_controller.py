@@ -422,15 +422,16 @@ class JointTrajectoryController(Controller):
         to that point, then the new points' segments; joints the message leaves out keep their trajectory."""
         points = list(message.points)
         start = message.start if message.start != 0.0 else time
-        numbers = [message.start] + [value for point in points for values in (
-            point.positions, point.velocities, point.accelerations, [point.time_from_start]) for value in values]
-        if not all(math.isfinite(value) for value in numbers):
-            raise TrajectoryError("Trajectory message contains a value that is not a finite number (NaN or inf would "
-                                  "reach the joints).")
+        names = list(message.joint_names)
+        times = [message.start] + [point.time_from_start for point in points]
+        # NaN or inf would reach the joints: refused, said once per joint and value.
+        if not (all(math.isfinite(value) for value in times) and all(
+                self.finite_command(names, values) for point in points
+                for values in (point.positions, point.velocities, point.accelerations))):
+            raise TrajectoryError("Trajectory message contains a value that is not a finite number.")
         for earlier, later in zip(points, points[1:]):
             if earlier.time_from_start >= later.time_from_start:
                 raise TrajectoryError("Trajectory message contains waypoints that are not strictly increasing in time.")
-        names = list(message.joint_names)
         if not self.allow_partial_joints_goal and len(names) != len(self.joint_names):
             raise TrajectoryError("Cannot create trajectory from message. It does not contain the expected joints.")
         mapping = self._mapping(names)
