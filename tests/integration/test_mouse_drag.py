@@ -6,6 +6,7 @@ has mass 0, which PyBullet cannot pick: it stays put (./mbot move places static 
 The simulation runs in this process (a Simulation in PyBullet's GUI mode) so the test can aim the mouse with the
 window's camera; xdotool presses and moves the mouse on a private Xvfb display.
 """
+import contextlib
 import math
 import os
 import subprocess
@@ -38,12 +39,16 @@ def insert(simulation, tmp_path, database_name, name, x, y):
     simulation.add_world(parse_world(str(path)))
 
 
+class WindowWithoutCamera(Exception):
+    """PyBullet's window answered getDebugVisualizerCamera with zeros throughout: on a loaded machine a window
+    at times never reports its camera (cause not found; a new window does)."""
+
+
 def window_pixel(simulation, point):
     """Where a world point appears in the window, from its camera's view and projection matrices (read again until
-    the window reports its camera: PyBullet answers zeros until then, at times for long on a loaded machine; the
-    simulation keeps stepping meanwhile)."""
+    the window reports its camera: PyBullet answers zeros until then; the simulation keeps stepping meanwhile)."""
     client = simulation.engine.client
-    deadline = time.monotonic() + 60.0
+    deadline = time.monotonic() + 20.0
     while True:
         camera = client.getDebugVisualizerCamera()
         width, height = camera[0], camera[1]
@@ -51,7 +56,8 @@ def window_pixel(simulation, point):
         clip = projection @ view @ np.array([point[0], point[1], point[2], 1.0])
         if np.isfinite(clip).all() and abs(clip[3]) > 1e-9:
             break
-        assert time.monotonic() < deadline, f"the window's camera was not set within 60 s: {camera[:4]}"
+        if time.monotonic() > deadline:
+            raise WindowWithoutCamera(f"the window's camera was not set within 20 s: {camera[:4]}")
         simulation.step(1)
         time.sleep(0.05)
     x, y = clip[:2] / clip[3]
@@ -78,7 +84,7 @@ def drag(display, start, end, steps):
     xdotool(display, "mouseup", "1")
 
 
-@pytest.fixture
+@contextlib.contextmanager
 def window_simulation(tmp_path):
     with Xvfb(tmp_path / "xvfb.log") as server:
         previous = os.environ.get("DISPLAY")
@@ -96,8 +102,20 @@ def window_simulation(tmp_path):
             simulation.close()
 
 
-def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulation, tmp_path):
-    simulation, server = window_simulation
+def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(tmp_path):
+    for attempt in range(2):
+        folder = tmp_path / f"window_{attempt}"
+        folder.mkdir()
+        with window_simulation(folder) as (simulation, server):
+            try:
+                drag_and_check(simulation, server, folder)
+                return
+            except WindowWithoutCamera as error:
+                print(f"{error}; opening a new window")
+    pytest.fail("two windows in a row never reported their camera")
+
+
+def drag_and_check(simulation, server, tmp_path):
     insert(simulation, tmp_path, "unit_box", "unit_box", 0.0, 0.0)
     insert(simulation, tmp_path, "cafe_table", "cafe_table", -1.5, -1.0)
     simulation.step(300)
