@@ -190,3 +190,16 @@ def test_bad_parameters_refuse_the_controller_or_leave_it_working(bad):
         controller.cancel_goal(None)
         sim.step(1000)
         assert all(math.isfinite(joint.position) for joint in controller.joints)
+
+
+def test_a_partial_goal_moves_its_joints_only_when_allowed():
+    sim, controller = trajectory_arm("Position")
+    partial = TrajectoryGoal(JointTrajectory(["shoulder"], [TrajectoryPoint([0.5], time_from_start=1.0)]))
+    assert controller.accept_goal(partial)[:2] == (False, INVALID_JOINTS)
+    sim, controller = trajectory_arm("Position", allow_partial_joints_goal=True)
+    elbow = controller.joints[1].position
+    assert controller.accept_goal(partial)[0]
+    assert run_until_ended(sim, controller).status == SUCCEEDED
+    sim.step(500)
+    assert controller.joints[0].position == pytest.approx(0.5, abs=0.01)
+    assert controller.joints[1].position == pytest.approx(elbow, abs=0.01)
