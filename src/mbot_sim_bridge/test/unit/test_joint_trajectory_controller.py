@@ -203,3 +203,17 @@ def test_a_partial_goal_moves_its_joints_only_when_allowed():
     sim.step(500)
     assert controller.joints[0].position == pytest.approx(0.5, abs=0.01)
     assert controller.joints[1].position == pytest.approx(elbow, abs=0.01)
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf, 1e308, -1e308])
+def test_bad_numbers_in_a_goals_tolerances_and_in_query_state_move_nothing(value):
+    sim, controller = trajectory_arm("Position")
+    tolerances = [JointTolerance(joint, value, value, value) for joint in JOINTS]
+    assert controller.accept_goal(goal([(0.5, [0.2, 0.2])], path_tolerance=tolerances, goal_tolerance=tolerances,
+                                       goal_time_tolerance=value))[0]
+    for _ in range(300):  # the goal ends one way or another, or runs on with the arm where it was sent
+        sim.step(10)
+        if controller.ended:
+            break
+    assert [joint.position for joint in controller.joints] == pytest.approx([0.2, 0.2], abs=0.01)
+    assert controller.query_state(value) is None or math.isfinite(value)

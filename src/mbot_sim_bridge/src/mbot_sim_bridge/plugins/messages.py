@@ -23,13 +23,6 @@ def set_pose(pose, position: Sequence[float], orientation: Sequence[float]):
     set_quaternion(pose.orientation, orientation)
 
 
-def set_wrench_stamped(message, stamp_seconds: float, force: Sequence[float], torque: Sequence[float]):
-    """A geometry_msgs/WrenchStamped refilled: stamp, force, torque (the frame stays as set)."""
-    message.header.stamp = ros_time(stamp_seconds)
-    set_xyz(message.wrench.force, force)
-    set_xyz(message.wrench.torque, torque)
-
-
 def diagonal_covariance(variances, size: int) -> list:
     """A row-major ``size`` x ``size`` covariance with ``variances`` on the diagonal (one value: on all of it)."""
     covariance = [0.0] * (size * size)

@@ -200,7 +200,6 @@ class RosJointTrajectoryController(_ActionController, JointTrajectoryController)
         self.state_publisher = loop_publisher(namespace + "/state", JointTrajectoryControllerState)
         self.subscriber = TrackedSubscriber(namespace + "/command", JointTrajectoryMessage, self._on_command)
         self.query_service = rospy.Service(namespace + "/query_state", QueryTrajectoryState, self._on_query)
-        self._last_feedback = -math.inf
         self._serve(namespace, "follow_joint_trajectory", FollowJointTrajectoryAction)
 
     def _on_command(self, message):
@@ -245,21 +244,13 @@ class RosJointTrajectoryController(_ActionController, JointTrajectoryController)
         self._send_ended()
         with self.lock:
             state = self._fill(JointTrajectoryControllerState(), stamp) if self.state_due else None
-            self.state_due = False
             active = self.active_goal
-            feedback = None
-            if (active is not None and self.action_monitor_period > 0.0
-                    and self.time - self._last_feedback >= self.action_monitor_period - 1e-9):
-                self._last_feedback = self.time
-                feedback = self._fill(FollowJointTrajectoryFeedback(), stamp)
+            feedback = self._fill(FollowJointTrajectoryFeedback(), stamp) if self.feedback_due and active else None
+            self.state_due = self.feedback_due = False
         if state is not None:
             self.state_publisher.publish(state)
         if feedback is not None:
             active.handle.publish_feedback(feedback)
-
-    def restart_clock(self, now):
-        super().restart_clock(now)
-        self._last_feedback = -math.inf
 
     def close(self):
         super().close()

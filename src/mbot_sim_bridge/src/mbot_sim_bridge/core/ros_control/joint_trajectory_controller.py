@@ -306,7 +306,8 @@ class JointTrajectoryController(Controller):
         self.times_from_start = (0.0, 0.0, 0.0)  # desired, actual, error
         self.ended: List[GoalEnd] = []
         self._last_state_publish = 0.0
-        self.state_due = False
+        self._last_feedback = -math.inf
+        self.state_due = self.feedback_due = False
 
     def _tolerances_from_params(self, constraints: dict) -> List[JointTolerances]:
         """getSegmentTolerances: ``<joint>/trajectory`` and ``<joint>/goal`` positions, the shared
@@ -335,6 +336,7 @@ class JointTrajectoryController(Controller):
 
     def restart_clock(self, now):
         self.time = now
+        self._last_feedback = -math.inf
 
     def _hold(self, uptime: float, goal: Optional[TrajectoryGoal] = None):
         """setHoldPosition: hold where the joints are, or stop smoothly over stop_trajectory_duration from the
@@ -446,7 +448,7 @@ class JointTrajectoryController(Controller):
                 for tolerance in goal.goal_tolerance:
                     if tolerance.name == joint:
                         tolerances[i].goal.update(tolerance)
-            if goal.goal_time_tolerance != 0.0:
+            if goal.goal_time_tolerance > 0.0 or goal.goal_time_tolerance < 0.0:  # NaN keeps the default
                 for joint_tolerances in tolerances:
                     joint_tolerances.goal_time = max(goal.goal_time_tolerance, 0.0)
         # The first point still to come (points at or before now are dropped; a first point at 0 silently).
@@ -495,14 +497,9 @@ class JointTrajectoryController(Controller):
     def update(self, now, period):
         with self.lock:
             self.time, self.period, self.uptime = now, period, self.uptime + period
-            self._update_states()
+            active_segments = self._update_states()
             goal = self.active_goal
-            for i, segments in enumerate(self.trajectory):
-                index = find_segment(segments, self.uptime)
-                if index is None:
-                    _logger.error(f"{self.name}: Unexpected error: No trajectory defined at current time. Please "
-                                  "contact the package maintainer.")
-                    return
+            for i, (segments, index) in enumerate(zip(self.trajectory, active_segments)):
                 segment = segments[index]
                 if goal is None or segment.goal is not goal:
                     continue
@@ -524,18 +521,26 @@ class JointTrajectoryController(Controller):
             if self.state_publish_period > 0.0 and self._last_state_publish + self.state_publish_period < self.uptime:
                 self._last_state_publish += self.state_publish_period
                 self.state_due = True
+            if (self.active_goal is not None and self.action_monitor_period > 0.0
+                    and self.time - self._last_feedback >= self.action_monitor_period - 1e-9):
+                self._last_feedback = self.time
+                self.feedback_due = True
 
     def _abort(self, error_code: int, error_string: str):
         self.ended.append(GoalEnd(self.active_goal, ABORTED, error_code, error_string))
         self.active_goal = None
         self.successful = [False] * len(self.joints)
 
-    def _update_states(self):
+    def _update_states(self) -> List[int]:
         """updateStates: desired from the trajectory, actual from the joints, the error between them (Noetic takes
-        the shortest angular distance for every joint, prismatic ones included)."""
+        the shortest angular distance for every joint, prismatic ones included). Returns each joint's active
+        segment (the first one if the time came before all, which the trajectories' construction rules out)."""
         desired, actual, error = ([], [], []), ([], []), ([], [], [])
+        active_segments = []
         for i, (joint, segments) in enumerate(zip(self.joints, self.trajectory)):
             index, (position, velocity, acceleration) = sample(segments, self.uptime)
+            index = 0 if index is None else index
+            active_segments.append(index)
             for values, value in zip(desired, (position, velocity, acceleration)):
                 values.append(value)
             actual[0].append(joint.position)
@@ -544,11 +549,12 @@ class JointTrajectoryController(Controller):
             error[1].append(velocity - joint.velocity)
             error[2].append(0.0)
             if i == 0:
-                segment = segments[0 if index is None else index]
+                segment = segments[index]
                 actual_from_start = self.uptime - segment.start_time + segment.time_from_start
                 self.times_from_start = (segment.time_from_start, actual_from_start,
                                          segment.time_from_start - actual_from_start)
         self.desired, self.actual, self.error = desired, actual, error
+        return active_segments
 
     def query_state(self, time: float) -> Optional[Tuple[List[float], List[float], List[float]]]:
         """query_state: the trajectory sampled at a sim time; None (with upstream's error) when it cannot be."""
@@ -557,6 +563,9 @@ class JointTrajectoryController(Controller):
                 _logger.error(f"{self.name}: Can't sample trajectory. Controller is not running.")
                 return None
             sample_time = self.uptime + (time - self.time)
+            if not math.isfinite(sample_time):
+                _logger.error(f"{self.name}: query_state: time {time} is not a finite number")
+                return None
             states = []
             for segments in self.trajectory:
                 index, state = sample(segments, sample_time)
@@ -567,4 +576,4 @@ class JointTrajectoryController(Controller):
             return [state[0] for state in states], [state[1] for state in states], [state[2] for state in states]
 
     def publish_due(self, now):
-        return self.state_due or bool(self.ended) or self.active_goal is not None
+        return self.state_due or self.feedback_due or bool(self.ended)
