@@ -23,7 +23,6 @@ from mbot_sim_bridge.core.log import c_stdout_to
 RPLIDAR = RaySensorConfig(sensor_name="rplidar", link="laser_link", samples=360, min_angle=-3.0,
                           max_angle=3.0, range_min=0.10, range_max=6.0, update_rate=5.5,
                           noise_mean=0.0, noise_stddev=0.01)
-ROBOT_GROUP = 1 << 8
 # The mbot's laser_link sits 0.08 m ahead of and 0.072 m above base_footprint.
 LASER_IN_BASE = pose_from_xyz_rpy((0.08, 0.0, 0.072), (0.0, 0.0, 0.0))
 
@@ -53,8 +52,6 @@ def build_world(client):
         linkPositions=[[0.08, 0, 0.03]], linkOrientations=[[0, 0, 0, 1]],
         linkInertialFramePositions=[[0, 0, 0]], linkInertialFrameOrientations=[[0, 0, 0, 1]],
         linkParentIndices=[0], linkJointTypes=[pybullet.JOINT_FIXED], linkJointAxis=[[0, 0, 1]])
-    for link in (-1, 0):
-        client.setCollisionFilterGroupMask(robot, link, ROBOT_GROUP, -1)
     return robot
 
 
@@ -71,16 +68,15 @@ def main():
         client = BulletClient(connection_mode=pybullet.DIRECT)
     build_world(client)
     scanner = LaserScanner(client, RPLIDAR, np.random.default_rng(0))
-    mask = -1 & ~ROBOT_GROUP
     # The robot turns on the spot so that each scan sees a different part of the room.
     poses = [compose(pose_from_xyz_rpy((0.0, 0.0, 0.0), (0.0, 0.0, yaw)), LASER_IN_BASE)
              for yaw in np.linspace(0.0, 2.0 * np.pi, args.scans, endpoint=False)]
     for pose in poses[:20]:
-        scanner.scan(pose, mask)
+        scanner.scan(pose)
     seconds = np.empty(args.scans)
     for i, pose in enumerate(poses):
         start = time.perf_counter()
-        scanner.scan(pose, mask)
+        scanner.scan(pose)
         seconds[i] = time.perf_counter() - start
     # The same rays cast with the transform, range maths and noise left out: the engine's share of a scan.
     yaws = angles(RPLIDAR)
@@ -91,7 +87,7 @@ def main():
         starts = directions * RPLIDAR.range_min @ rotation.T + pose.position
         ends = directions * RPLIDAR.range_max @ rotation.T + pose.position
         start = time.perf_counter()
-        client.rayTestBatch(starts, ends, collisionFilterMask=mask)
+        client.rayTestBatch(starts, ends)
         ray_seconds[i] = time.perf_counter() - start
     client.disconnect()
     beams = RPLIDAR.range_count

@@ -11,6 +11,7 @@ from gazebo_msgs.msg import ModelStates
 
 from .plugins import loop_publisher
 
+WIRE_FLOAT = np.dtype("<f8")  # ROS float64 on the wire; filled in place, so serializing needs no conversion
 
 def serialized_names(names) -> bytes:
     """A ROS string[]: its length, then each string's byte length and bytes (little-endian uint32)."""
@@ -19,9 +20,10 @@ def serialized_names(names) -> bytes:
 
 
 def serialized(names_bytes: bytes, poses: np.ndarray, twists: np.ndarray) -> bytes:
-    """ModelStates on the wire: name[], then Pose[] (x y z, qx qy qz qw) and Twist[] (linear, angular)."""
+    """ModelStates on the wire: name[], then Pose[] (x y z, qx qy qz qw) and Twist[] (linear, angular); the
+    arrays are little-endian float64 (WIRE_FLOAT)."""
     count = struct.pack("<I", len(poses))
-    return b"".join((names_bytes, count, poses.astype("<f8").tobytes(), count, twists.astype("<f8").tobytes()))
+    return b"".join((names_bytes, count, poses.tobytes(), count, twists.tobytes()))
 
 
 class _Serialized(ModelStates):
@@ -40,8 +42,8 @@ class ModelStatesPublisher:
         self._version = None
         self._names = []
         self._moving = []  # (row, name) of the models whose pose can change by itself
-        self._poses = np.zeros((0, 7))
-        self._twists = np.zeros((0, 6))
+        self._poses = np.zeros((0, 7), WIRE_FLOAT)
+        self._twists = np.zeros((0, 6), WIRE_FLOAT)
         self._names_bytes = b""
 
     def publish(self):
@@ -60,8 +62,8 @@ class ModelStatesPublisher:
         self._version = sim.version
         self._names = sim.model_names()
         self._names_bytes = serialized_names(self._names)
-        self._poses = np.zeros((len(self._names), 7))
-        self._twists = np.zeros((len(self._names), 6))
+        self._poses = np.zeros((len(self._names), 7), WIRE_FLOAT)
+        self._twists = np.zeros((len(self._names), 6), WIRE_FLOAT)
         static = {name for name, model in sim.world_models.items() if model.static}
         self._moving = [(row, name) for row, name in enumerate(self._names) if name not in static]
         for row, name in enumerate(self._names):

@@ -23,6 +23,7 @@ from .gazebo_paths import model_path
 from .core.sdf_world import parse_world
 from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
 from .core.xml_values import parse_bool
+from . import loop_publishing
 from .plugins import loop_publisher, ros_time
 from .publisher_check import check_joint_state_publishers
 from .package_uris import resolve_package_uris
@@ -48,6 +49,8 @@ def _bool_param(name: str, default: bool) -> bool:
 
 class SimBridgeNode:
     def __init__(self):
+        # First: the writer process starts while the world loads, and every loop publisher writes through it.
+        self.publishing = loop_publishing.start()
         # Every ~param is read here, once (teleop_twist_keyboard style), and logged once below.
         self.world_path = rospy.get_param("~world_name", "") or os.path.join(_workspace_worlds(), "empty.world")
         paused = _bool_param("~paused", False)
@@ -118,8 +121,10 @@ class SimBridgeNode:
         so the nodes' ROS time is the sim time the answer reports."""
         while count > 0 and not self._stop.is_set():  # Ctrl-C ends a long request too
             count -= self.sim.advance(count, self._before_updates)
+            self.publishing.flush(wait=True)
         if self._last_clock < self.sim.sim_time:
             self._publish_clock(self.sim.sim_time)
+        self.publishing.sync()
         self._restart_pacing()
 
     def run(self, stop: threading.Event):
@@ -128,9 +133,11 @@ class SimBridgeNode:
         while not (stop.is_set() or rospy.is_shutdown()):
             self._serve_requests(block=self.sim.paused)
             if self.sim.paused:
+                self.publishing.flush()
                 continue
             until_clock = self.clock_timer.steps_until_due(self.sim.sim_time, self.step_size)
             self.sim.advance(min(until_clock, self._batch_steps), self._before_updates)
+            self.publishing.flush(wait=True)
             check_joint_state_publishers(rospy.get_name(), (model.namespace for model in self.sim.models.values()))
             self._pace()
 
@@ -172,10 +179,12 @@ class SimBridgeNode:
         target = self._pace_wall_start + (self.sim.sim_time - self._pace_sim_start) / self.real_time_factor
         ahead = target - time.monotonic()
         if ahead > _PACING_SLACK_SECONDS:
+            self.publishing.flush()
             time.sleep(ahead)
 
     def close(self):
         self.sim.close()
+        loop_publishing.stop()
 
 
 def _workspace_worlds() -> str:

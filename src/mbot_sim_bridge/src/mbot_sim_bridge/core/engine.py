@@ -3,6 +3,7 @@
 Each Engine owns its own BulletClient (never PyBullet's module-global client), so tests can run several
 side by side. Sim time is kept as a whole number of physics steps, so it never drifts.
 """
+import functools
 import math
 import os
 import tempfile
@@ -28,6 +29,17 @@ MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
+
+
+class CachingBulletClient(BulletClient):
+    """A BulletClient that binds each PyBullet function to its client once: BulletClient builds a new
+    functools.partial on every attribute access, a few per cent of the bridge's loop."""
+
+    def __getattr__(self, name):
+        attribute = super().__getattr__(name)
+        if name != "disconnect" and isinstance(attribute, functools.partial):
+            setattr(self, name, attribute)  # found in the instance from now on, without __getattr__
+        return attribute
 
 
 @dataclass
@@ -181,7 +193,7 @@ class SpawnedRobot:
 
 class Engine:
     def __init__(self, physics: PhysicsConfig = PhysicsConfig(), connection_mode: int = pybullet.DIRECT):
-        self.client = BulletClient(connection_mode=connection_mode)
+        self.client = CachingBulletClient(connection_mode=connection_mode)
         self.physics = physics
         self._configure()
         self.steps = 0

@@ -6,22 +6,16 @@ and the values they leave). ``registry.REGISTRY`` maps the Gazebo file name to i
 thread that owns the engine; subscriber callbacks only store values under the core's lock. Messages are
 built in ``messages.py``.
 """
-import warnings
 from typing import Optional
 
 import rospy
 
+from ..loop_publishing import LoopPublisher
 
-def loop_publisher(name: str, message_type) -> rospy.Publisher:
-    """A publisher written to synchronously by the loop thread.
 
-    rospy's queued publishers hand each message to a writer thread and then call time.sleep(0) to yield the
-    GIL, a hand-off that costs more than a physics step. The loop is the only thread publishing these topics,
-    so it writes them itself (queue_size=None); rospy warns about that choice, which here is deliberate.
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SyntaxWarning)
-        return rospy.Publisher(name, message_type, queue_size=None)
+def loop_publisher(name: str, message_type) -> LoopPublisher:
+    """A publisher written to synchronously by the loop thread (loop_publishing.py)."""
+    return LoopPublisher(name, message_type)
 
 
 def ros_time(sim_seconds: float) -> rospy.Time:
@@ -43,7 +37,7 @@ class PluginTopics:
     def __init__(self):
         self._owned = []
 
-    def publisher(self, name: str, message_type) -> rospy.Publisher:
+    def publisher(self, name: str, message_type) -> LoopPublisher:
         return self.own(loop_publisher(name, message_type))
 
     def own(self, handle):
@@ -52,7 +46,7 @@ class PluginTopics:
         return handle
 
     @staticmethod
-    def listened(*publishers: Optional[rospy.Publisher]) -> bool:
+    def listened(*publishers: Optional[LoopPublisher]) -> bool:
         return any(publisher is not None and publisher.get_num_connections() > 0 for publisher in publishers)
 
     def close(self):

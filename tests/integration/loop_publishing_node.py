@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Drives loop_publishing against real rospy subscribers in this process; prints one 'figure:' line per check,
+or exits non-zero naming the check that failed (test_loop_publishing.py)."""
+import os
+import sys
+import time
+
+import rospy
+from mbot_sim_bridge import loop_publishing
+from geometry_msgs.msg import PointStamped
+from std_msgs.msg import String
+
+
+def wait_until(condition, what, publish=None, timeout=10.0):
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            sys.exit(f"timed out: {what}")
+        if publish is not None:
+            publish()
+        time.sleep(0.01)
+
+
+def main():
+    rospy.init_node("loop_publishing_check", disable_signals=True)
+    publishing = loop_publishing.start()
+    chatter = loop_publishing.LoopPublisher("/chatter", String)
+    stamped = loop_publishing.LoopPublisher("/stamped", PointStamped)
+    received, headers = [], []
+    subscriber = rospy.Subscriber("/chatter", String, lambda message: received.append(message.data))
+    rospy.Subscriber("/stamped", PointStamped, lambda message: headers.append(message.header.seq))
+    wait_until(lambda: chatter.get_num_connections() == 1 and stamped.get_num_connections() == 1, "connections")
+
+    for number in range(300):
+        chatter.publish(String(data=str(number)))
+        stamped.publish(PointStamped())
+        if number % 7 == 0:
+            publishing.flush()
+    publishing.sync()
+    wait_until(lambda: len(received) == 300 and len(headers) == 300, "300 messages on each topic")
+    if received != [str(number) for number in range(300)] or headers != list(range(1, 301)):
+        sys.exit(f"messages out of order or header.seq not counted: {received[:5]} {headers[:5]}")
+    print("figure: 300 messages on each of two topics arrived in order, header.seq 1 to 300")
+
+    # A subscriber that leaves is found by the writer and its connection closed in rospy.
+    subscriber.unregister()
+    wait_until(lambda: chatter.get_num_connections() == 0, "the departed subscriber's connection closed",
+               publish=lambda: (chatter.publish(String(data="x")), publishing.flush()))
+    print("figure: a departed subscriber's connection is closed in rospy")
+
+    # A new subscriber receives, on a new connection.
+    again = []
+    rospy.Subscriber("/chatter", String, lambda message: again.append(message.data))
+    wait_until(lambda: chatter.get_num_connections() == 1, "the new connection")
+    chatter.publish(String(data="again"))
+    publishing.sync()
+    wait_until(lambda: again == ["again"], "a message on the new connection")
+    print("figure: a new subscriber receives on its new connection")
+
+    # A publisher that unregisters: the writer closes its copies of the publisher's sockets too.
+    def writer_descriptors():
+        return len(os.listdir(f"/proc/{publishing.process.pid}/fd"))
+    before = writer_descriptors()
+    stamped.unregister()
+    publishing.sync()
+    if writer_descriptors() != before - 1:
+        sys.exit(f"the writer holds {writer_descriptors()} descriptors after unregistering, {before} before")
+    print("figure: unregistering a publisher closes the writer's copy of its connection")
+
+    started = time.monotonic()
+    process = publishing.process
+    loop_publishing.stop()
+    if process.poll() is None:
+        sys.exit("the writer process outlived stop()")
+    print(f"figure: the writer stopped {time.monotonic() - started:.3f} s after stop()")
+
+
+if __name__ == "__main__":
+    main()
