@@ -74,6 +74,21 @@ def main():
         sys.exit("the writer process outlived stop()")
     print(f"figure: the writer stopped {time.monotonic() - started:.3f} s after stop()")
 
+    # A writer that dies is reported by the loop's next flush, not by a plugin's publish.
+    publishing = loop_publishing.start()
+    late = loop_publishing.LoopPublisher("/late", String)
+    rospy.Subscriber("/late", String, lambda message: None)
+    wait_until(lambda: late.get_num_connections() == 1, "the connection to /late")
+    publishing.process.kill()
+    publishing.process.wait()
+    late.publish(String(data="into the void"))
+    try:
+        publishing.flush()
+        sys.exit("flush() after the writer died raised nothing")
+    except loop_publishing.WriterStopped as error:
+        print(f"figure: a dead writer is reported: {error}")
+    loop_publishing.stop()
+
 
 if __name__ == "__main__":
     main()

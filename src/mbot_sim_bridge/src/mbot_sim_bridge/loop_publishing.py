@@ -54,6 +54,7 @@ class LoopPublishing:
         self._answers = bytearray()
         self._next_answers_read = 0.0
         self._batch_started = 0.0
+        self._failure: Optional[OSError] = None
         # Publishing and flushing come from the loop thread; the lock keeps a publish from another thread whole.
         self._lock = threading.RLock()
 
@@ -87,7 +88,10 @@ class LoopPublishing:
         self._next_id += 1
         # The descriptor travels with its OPEN frame, so everything batched before it goes first.
         self._send_batch()
-        socket.send_fds(self._channel, [ID.pack(OPEN, number)], [connection.socket.fileno()])
+        try:
+            socket.send_fds(self._channel, [ID.pack(OPEN, number)], [connection.socket.fileno()])
+        except OSError as error:
+            self._failure = self._failure or error
         self._ids[connection] = (number, impl)
         self._connections[number] = connection
         return number
@@ -113,6 +117,7 @@ class LoopPublishing:
             if wait and now - self._batch_started < COALESCE_SECONDS and len(self._batch) < _COALESCE_BYTES:
                 return
             self._send_batch()
+            self._raise_failure()
             if now >= self._next_answers_read:
                 self._next_answers_read = now + _ANSWERS_READ_SECONDS
                 self._read_answers(None)
@@ -124,15 +129,23 @@ class LoopPublishing:
             self._next_token += 1
             self._batch += ID.pack(SYNC, token)
             self._send_batch()
+            self._raise_failure()
             self._read_answers(token)
 
     def _send_batch(self):
-        if self._batch:
+        """Hand the batch over. A failure is kept for the loop's next flush to raise: raised inside a plugin's
+        publish, it would be taken for that plugin's failure."""
+        if self._batch and self._failure is None:
             try:
                 self._channel.sendall(self._batch)
             except OSError as error:
-                raise WriterStopped(f"the writer process stopped ({error}); nothing more can be published") from None
-            self._batch.clear()
+                self._failure = error
+        self._batch.clear()
+
+    def _raise_failure(self):
+        if self._failure is not None:
+            raise WriterStopped(f"the writer process stopped ({self._failure}, exit status "
+                                f"{self.process.poll()}); nothing more can be published")
 
     def _read_answers(self, token: Optional[int]):
         """Read the writer's answers; with a token, until that SYNCED arrives."""

@@ -215,6 +215,9 @@ def main():
         sys.exit(1)
     try:
         node.run(stop)
+    except loop_publishing.WriterStopped as error:
+        rospy.logfatal(str(error))
+        sys.exit(1)
     finally:
         node.close()
         rospy.signal_shutdown("stopped")
