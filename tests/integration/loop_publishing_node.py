@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
 """Drives loop_publishing against real rospy subscribers in this process; prints one 'figure:' line per check,
 or exits non-zero naming the check that failed (test_loop_publishing.py)."""
+import io
 import os
 import sys
 import time
 
+import numpy as np
 import rospy
 from mbot_sim_bridge import loop_publishing
+from mbot_sim_bridge.core.imu import ImuReading, ImuReadings
+from mbot_sim_bridge.plugins.messages import imu_message, imu_records
 from geometry_msgs.msg import PointStamped
+from sensor_msgs.msg import Imu
 from std_msgs.msg import String
 
 
@@ -19,6 +24,39 @@ def wait_until(condition, what, publish=None, timeout=10.0):
         if publish is not None:
             publish()
         time.sleep(0.01)
+
+
+def serialized(message) -> bytes:
+    buffer = io.BytesIO()
+    message.serialize(buffer)
+    return buffer.getvalue()
+
+
+def check_records(publishing):
+    """Messages serialized as numpy records (the every-step IMU's) arrive as genpy would have made them,
+    numbered in turn with a message published the usual way."""
+    imu = loop_publishing.LoopPublisher("/imu", Imu)
+    received = []
+    rospy.Subscriber("/imu", Imu, received.append)
+    wait_until(lambda: imu.get_num_connections() == 1, "the connection to /imu")
+    rng = np.random.default_rng(3)
+    orientations = rng.normal(size=(3, 4))
+    readings = ImuReadings(np.array([0.001, 41.0025, 1e6 + 0.0000005]), orientations / np.linalg.norm(
+        orientations, axis=1)[:, None], rng.normal(size=(3, 3)), rng.normal(size=(3, 3)), 0.25)
+    rows = [ImuReading(float(readings.stamps[row]), tuple(readings.orientations[row]),
+                       tuple(readings.angular_velocities[row]), tuple(readings.linear_accelerations[row]), 0.25)
+            for row in range(3)]
+    imu.publish_records(imu_records(readings, "imu_link"))
+    imu.publish(imu_message(rows[0], "imu_link"))
+    publishing.sync()
+    wait_until(lambda: len(received) == 4, "four /imu messages")
+    for seq, (message, row) in enumerate(zip(received, rows + rows[:1]), start=1):
+        expected = imu_message(row, "imu_link")
+        expected.header.seq = seq
+        if serialized(message) != serialized(expected):
+            sys.exit(f"/imu message {seq} differs from genpy's:\n{message}\nexpected\n{expected}")
+    print("figure: three Imu readings sent as numpy records arrived as genpy's messages, header.seq 1 to 3, "
+          "then a genpy message as 4")
 
 
 def main():
@@ -41,6 +79,7 @@ def main():
     if received != [str(number) for number in range(300)] or headers != list(range(1, 301)):
         sys.exit(f"messages out of order or header.seq not counted: {received[:5]} {headers[:5]}")
     print("figure: 300 messages on each of two topics arrived in order, header.seq 1 to 300")
+    check_records(publishing)
 
     # A subscriber that leaves is found by the writer and its connection closed in rospy.
     subscriber.unregister()

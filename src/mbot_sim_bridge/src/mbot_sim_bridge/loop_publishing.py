@@ -20,6 +20,7 @@ import time
 import warnings
 from typing import Dict, List, Optional, Tuple
 
+import numpy as np
 import rospy
 from rospy.msg import serialize_message
 
@@ -60,8 +61,8 @@ class LoopPublishing:
 
     def publish(self, impl, message):
         with impl.publock, self._lock:
-            connections = [connection for connection in impl.connections if not connection.done]
-            if impl.closed or not connections:
+            connections = self._open_connections(impl)
+            if not connections:
                 return
             buffer = impl.buff
             impl.seq += 1
@@ -69,16 +70,33 @@ class LoopPublishing:
             data = buffer.getvalue()
             buffer.seek(0)
             buffer.truncate(0)
-            impl.message_data_sent += len(data)
-            ids = [self._id(connection, impl) for connection in connections]
-            if not self._batch:
-                self._batch_started = time.monotonic()
-            self._batch += DATA_HEADER.pack(DATA, len(ids), len(data))
-            self._batch += struct.pack(f"<{len(ids)}I", *ids)
-            self._batch += data
-            for connection in connections:
-                connection.stat_bytes += len(data)
-                connection.stat_num_msg += 1
+            self._append(impl, connections, data, 1)
+
+    def publish_records(self, impl, records: np.ndarray):
+        """Messages serialized as numpy records (``length`` prefix first, header ``seq`` to fill), in one piece."""
+        with impl.publock, self._lock:
+            connections = self._open_connections(impl)
+            if not connections or not len(records):
+                return
+            records["seq"] = np.arange(impl.seq + 1, impl.seq + 1 + len(records))
+            impl.seq += len(records)
+            self._append(impl, connections, records.tobytes(), len(records))
+
+    @staticmethod
+    def _open_connections(impl) -> list:
+        return [] if impl.closed else [connection for connection in impl.connections if not connection.done]
+
+    def _append(self, impl, connections: list, data: bytes, count: int):
+        impl.message_data_sent += len(data)
+        ids = [self._id(connection, impl) for connection in connections]
+        if not self._batch:
+            self._batch_started = time.monotonic()
+        self._batch += DATA_HEADER.pack(DATA, len(ids), len(data))
+        self._batch += struct.pack(f"<{len(ids)}I", *ids)
+        self._batch += data
+        for connection in connections:
+            connection.stat_bytes += len(data)
+            connection.stat_num_msg += count
 
     def _id(self, connection, impl) -> int:
         known = self._ids.get(connection)
@@ -220,6 +238,14 @@ class LoopPublisher:
             self._publisher.publish(message)
         else:
             self._publishing.publish(self._publisher.impl, message)
+
+    def publish_records(self, records: np.ndarray):
+        """Messages already serialized as numpy records (``messages.imu_records``), numbered and sent at once."""
+        if self._publishing is None:
+            for record in records:
+                self._publisher.publish(self.data_class().deserialize(record.tobytes()[4:]))
+        else:
+            self._publishing.publish_records(self._publisher.impl, records)
 
     def get_num_connections(self) -> int:
         return self._publisher.get_num_connections()

@@ -4,6 +4,7 @@ A timer never counts calls: it compares sim time with its last firing and advanc
 (``last += period``), so a rate holds exactly over a long run instead of drifting with the step size.
 """
 import math
+import sys
 
 # Sim time is a whole number of steps times the step size; this absorbs the rounding of that product.
 _EPSILON = 1e-9
@@ -44,3 +45,19 @@ class UpdateTimer:
         steps = remaining / step_size
         whole = math.floor(steps + _EPSILON) + 1 if self.strict else math.ceil(steps - _EPSILON)
         return max(1, whole)
+
+
+class EveryStopTimer:
+    """Due whenever the loop stops for another event, never asking it to stop: the timer of a plugin that
+    records every physics step (``Plugin.step_recorder``) and reports the recorded steps together."""
+
+    period = 0.0
+
+    def reset(self, now: float):
+        pass
+
+    def due(self, now: float) -> bool:
+        return True
+
+    def steps_until_due(self, now: float, step_size: float) -> int:
+        return sys.maxsize

@@ -8,13 +8,14 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
+import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from .errors import ModelError
-from .geometry import IDENTITY, Pose, compose, inverse
+from .geometry import IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotation_matrices
 from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
 from .world_description import PhysicsConfig
@@ -164,6 +165,39 @@ class SpawnedRobot:
         state = self.client.getLinkState(self.body, index, computeLinkVelocity=True)
         return _point_velocity(state[0], state[6], state[7], point)
 
+    def link_state_recorder(self, link_name: str, rows: list) -> Callable[[], None]:
+        """A call that appends the Bullet state of ``link_name``'s body link to ``rows``, for ``Engine.step`` to
+        make after every step (about 2 us); ``recorded_link_states`` turns the rows into world values."""
+        index = self.link_index[self.model.lumped_into[link_name][0]]
+        body, append = self.body, rows.append
+        if index == -1:
+            pose, velocity = self.client.getBasePositionAndOrientation, self.client.getBaseVelocity
+            return lambda: append(pose(body) + velocity(body))
+        state = self.client.getLinkState
+        return lambda: append(state(body, index, 1, 1))
+
+    def recorded_link_states(self, link_name: str, rows: Sequence[tuple]):
+        """From ``link_state_recorder``'s rows, what ``link_world_pose`` and ``link_world_velocity`` said at each
+        step, as (N, 3) positions, (N, 4) orientations, (N, 3) linear and (N, 3) angular velocities."""
+        body_link, offset = self.model.lumped_into[link_name]
+        if self.link_index[body_link] == -1:
+            com = np.array([position + orientation + linear + angular
+                            for position, orientation, linear, angular in rows], dtype=float).reshape(-1, 13)
+            com_positions, com_orientations = com[:, :3], com[:, 3:7]
+            linear, angular = com[:, 7:10], com[:, 10:13]
+            frame = self.root_from_com
+            positions = com_positions + rotation_matrices(com_orientations) @ frame.position
+            orientations = quaternion_products(com_orientations, frame.orientation)
+        else:
+            # getLinkState: 0 centre of mass, 4 and 5 the link frame, 6 and 7 the centre of mass's velocity.
+            state = np.array([row[0] + row[4] + row[5] + row[6] + row[7] for row in rows], dtype=float).reshape(-1, 16)
+            com_positions, positions, orientations = state[:, :3], state[:, 3:6], state[:, 6:10]
+            linear, angular = state[:, 10:13], state[:, 13:16]
+        if offset != IDENTITY:
+            positions = positions + rotation_matrices(orientations) @ offset.position
+            orientations = quaternion_products(orientations, offset.orientation)
+        return positions, orientations, linear + cross_products(angular, positions - com_positions), angular
+
     def set_root_velocity(self, linear: Sequence[float], angular: Sequence[float]):
         """The base's world-frame velocity (of its centre of mass), as Gazebo's Model::SetLinearVel and
         SetAngularVel set the canonical link's."""
@@ -233,10 +267,17 @@ class Engine:
     def sim_time(self) -> float:
         return self.steps * self.physics.max_step_size
 
-    def step(self, count: int = 1):
+    def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
+        """``count`` physics steps; ``after_each`` (recorders of per-step state) is called after every one."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
-        for _ in range(count):
-            step()
+        if after_each:
+            for _ in range(count):
+                step()
+                for record in after_each:
+                    record()
+        else:
+            for _ in range(count):
+                step()
         self.steps += count
 
     def add_world(self, world: LoadedWorld):

@@ -11,7 +11,10 @@
   0 m/s². ``xyzOffset`` has no effect. ``<imu><noise>`` blocks (TurtleBot3 writes one) are never read.
 - every covariance diagonal is gaussianNoise², frame_id = frameName (default bodyName);
 - ``updateRate`` 0 = every physics step, as in Gazebo (TurtleBot3: 1000 messages a sim second); nothing is
-  computed while nobody subscribes, and the bridge then looks only every IDLE_PERIOD.
+  computed while nobody subscribes, and the bridge then looks only every IDLE_PERIOD. While read, the body's
+  state is recorded after every step (one PyBullet query) and the readings of the recorded steps are
+  computed together with numpy when the loop next stops (at most MAX_BATCH_SIM_SECONDS later), each stamped
+  with its own step, so the plugin no longer makes the loop stop at every step.
 - sdformat renames a ``bodyName``/``frameName`` that names a link lumped by a fixed joint to the surviving
   parent link (that is why TurtleBot3's /imu says frame_id base_footprint in Gazebo); the bridge does the same.
 
@@ -33,9 +36,10 @@ from typing import NamedTuple, Optional, Tuple
 import numpy as np
 
 from . import names
-from .clock import UpdateTimer
+from .clock import EveryStopTimer, UpdateTimer
 from .errors import ConfigError
-from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, rotation_matrix
+from .geometry import (IDENTITY, Pose, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrices,
+                       rotation_matrix)
 from .log import get_logger, warn_once
 from .params import Param, PluginParams, non_negative
 from .plugin import Plugin
@@ -58,6 +62,19 @@ class ImuReading(NamedTuple):
     covariance: float  # the value on every covariance diagonal
 
 
+class ImuReadings(NamedTuple):
+    """Readings of consecutive steps, one row each."""
+    stamps: np.ndarray  # (N,) sim seconds
+    orientations: np.ndarray  # (N, 4) x, y, z, w
+    angular_velocities: np.ndarray  # (N, 3)
+    linear_accelerations: np.ndarray  # (N, 3)
+    covariance: float
+
+    def last(self) -> ImuReading:
+        return ImuReading(float(self.stamps[-1]), tuple(self.orientations[-1]), tuple(self.angular_velocities[-1]),
+                          tuple(self.linear_accelerations[-1]), self.covariance)
+
+
 def read_vector_param(element: ET.Element, tag: str, label: str, where: str) -> Optional[Vector]:
     """A three-number tag (xyzOffset, rpyOffset) or None when absent; ConfigError naming it when bad."""
     child = element.find(tag)
@@ -75,7 +92,7 @@ def gazebo_body(robot, name: str) -> Tuple[str, Pose]:
 
 
 class _VelocityDifference:
-    """Δv/Δt of a world velocity between calls, as both IMUs form their accelerations."""
+    """Δv/Δt of a world velocity between calls, as the IMU sensor forms its acceleration."""
 
     def __init__(self):
         self.last_velocity: Optional[np.ndarray] = None
@@ -128,39 +145,77 @@ class ImuModelPlugin(Plugin):
         self.frame_name = gazebo_body(robot, frame)[0] if frame in robot.model.lumped_into else frame
         read_vector_param(element, "xyzOffset", self.label, where)
         rpy = read_vector_param(element, "rpyOffset", self.label, where) or (0.0, 0.0, 0.0)
-        self.offset = pose_from_xyz_rpy((0.0, 0.0, 0.0), rpy)
+        self.offset = pose_from_xyz_rpy((0.0, 0.0, 0.0), rpy).orientation
         self.noise = self.params["gaussianNoise"]
         self.rng = context.random_stream(element.get("name") or "imu")
-        now = context.simulation.sim_time
+        simulation = context.simulation
+        now = simulation.sim_time
         self.timer = UpdateTimer(self.params["updateRate"], start=now)
         self.period = self.timer.period
-        self.difference = _VelocityDifference()
-        self.difference.reset(robot.link_world_velocity(self.link)[0], now)
-        self.latest: Optional[ImuReading] = None
+        # A rate at or above the physics rate reads every step, as updateRate 0 does.
+        self.every_step = self.period <= simulation.step_size * (1.0 + 1e-9)
+        self._stopping_timer, self._every_stop_timer = self.timer, EveryStopTimer()
+        self._rows = []  # the body's recorded Bullet states since the last reading
+        self._recording = False
+        self._last_velocity = np.asarray(robot.link_world_velocity(self.link)[0], dtype=float)
+        self._last_time = now
+        self.readings: Optional[ImuReadings] = None
+
+    @property
+    def latest(self) -> Optional[ImuReading]:
+        return None if self.readings is None else self.readings.last()
+
+    def step_recorder(self, now: float):
+        if not self._recording:
+            return None
+        return self.context.robot.link_state_recorder(self.link, self._rows)
 
     def reset(self, now: float):
         super().reset(now)
-        self.difference.reset(self.context.robot.link_world_velocity(self.link)[0], now)
+        self._rows.clear()
+        self._last_velocity = np.asarray(self.context.robot.link_world_velocity(self.link)[0], dtype=float)
+        self._last_time = now
 
     def idle(self, now: float):
         """While nothing reads the IMU, look again only every IDLE_PERIOD instead of every step; Gazebo keeps
         its last time and velocity meanwhile, and the next reading differences from them."""
-        self.timer.period = max(self.period, IDLE_PERIOD)
-
-    def read(self, now: float) -> ImuReading:
-        robot = self.context.robot
-        pose = robot.link_world_pose(self.link)
-        linear, angular = robot.link_world_velocity(self.link)
-        orientation = compose(self.offset, Pose((0.0, 0.0, 0.0), pose.orientation)).orientation
-        rotation = np.asarray(rotation_matrix(orientation))
-        noise = self.rng.normal(0.0, self.noise, 6) if self.noise > 0 else np.zeros(6)
-        acceleration = self.difference(linear, now)
-        return ImuReading(now, tuple(orientation), tuple(rotation @ (np.asarray(angular) + noise[:3])),
-                          tuple(rotation @ (acceleration + noise[3:])), self.noise ** 2)
+        self._recording = False
+        self._rows.clear()
+        self.timer = self._stopping_timer
+        if self.timer.period < IDLE_PERIOD:
+            self.timer.period = IDLE_PERIOD
+            self.timer.reset(now)
 
     def update(self, now: float):
-        self.timer.period = self.period
-        self.latest = self.read(now)
+        if not self._rows:  # the first reading after idle, or a rate below the physics rate: the state now
+            self.context.robot.link_state_recorder(self.link, self._rows)()
+        self.readings = self.read()
+        self._rows.clear()
+        if self.every_step:
+            self._recording = True
+            self.timer = self._every_stop_timer
+        else:
+            self.timer.period = self.period
+
+    def read(self) -> ImuReadings:
+        """The readings of the recorded rows, which end at the current step."""
+        simulation = self.context.simulation
+        count, step, last_step = len(self._rows), simulation.step_size, simulation.engine.steps
+        stamps = np.arange(last_step - count + 1, last_step + 1) * step
+        _, orientations, velocities, angular = self.context.robot.recorded_link_states(self.link, self._rows)
+        if self.offset != IDENTITY.orientation:
+            orientations = quaternion_products(self.offset, orientations)
+        # Δv/Δt from each step's velocity and the one before (the last reading's for the first row).
+        accelerations = np.diff(velocities, axis=0, prepend=self._last_velocity[None])
+        first_interval = stamps[0] - self._last_time
+        accelerations[0] = accelerations[0] / first_interval if first_interval > 0 else 0.0
+        accelerations[1:] /= step
+        self._last_velocity, self._last_time = velocities[-1], stamps[-1]
+        if self.noise > 0:
+            noise = self.rng.normal(0.0, self.noise, (count, 6))
+            angular, accelerations = angular + noise[:, :3], accelerations + noise[:, 3:]
+        rotated = rotation_matrices(orientations) @ np.stack((angular, accelerations), axis=-1)
+        return ImuReadings(stamps, orientations, rotated[..., 0], rotated[..., 1], self.noise ** 2)
 
 
 class AxisNoise(NamedTuple):

@@ -6,7 +6,7 @@ and one line in the plugin table (``core/plugin_table.py``). The Simulation buil
 ``update(now)`` when its timer is due and ``on_step`` after each physics step if it asks for it.
 """
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Dict, Optional, Sequence, Tuple
+from typing import TYPE_CHECKING, Any, Callable, Dict, Optional, Sequence, Tuple
 from xml.etree import ElementTree
 
 import numpy as np
@@ -114,6 +114,12 @@ class Plugin:
 
     def on_step(self, step_size: float):
         """After every physics step, when ``needs_every_step``."""
+
+    def step_recorder(self, now: float) -> Optional[Callable[[], None]]:
+        """Before the loop steps: a call to make after each of its physics steps (it should only read state,
+        as ``SpawnedRobot.link_state_recorder`` does), or None. The plugin's update then gets the recorded
+        steps at the next stop of the loop, so it needs no stop of its own (``clock.EveryStopTimer``)."""
+        return None
 
     def update(self, now: float):
         """When ``timer`` is due, with the sim time in seconds: compute the outputs into the plugin's state."""

@@ -80,6 +80,7 @@ class Simulation:
         self._build_order: List[object] = []
         self._plugins: List[Plugin] = []
         self._every_step: List[Plugin] = []
+        self._recording: List[Plugin] = []
         self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
@@ -299,6 +300,7 @@ class Simulation:
         self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
                          for plugin in spawned.plugins]
         self._every_step = [plugin for plugin in self._plugins if plugin.needs_every_step]
+        self._recording = [plugin for plugin in self._plugins if type(plugin).step_recorder is not Plugin.step_recorder]
 
     # -- stepping ------------------------------------------------------------------------------------------------
     def steps_to_next_event(self) -> int:
@@ -317,7 +319,8 @@ class Simulation:
         count = max(1, min(max_steps, self.steps_to_next_event()))
         if self.wrenches.pending() or self.wrenches.applied:
             self._apply_wrenches()
-        self.engine.step(count)
+        recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
+        self.engine.step(count, [recorder for recorder in recorders if recorder is not None])
         broken = self.engine.robots_not_finite()
         if broken:
             self._freeze(broken)
@@ -359,9 +362,10 @@ class Simulation:
             count -= self.advance(count, before_updates)
 
     def _guarded(self, plugin: Plugin, method, argument):
-        """A plugin that raises is logged once, closed and dropped; the simulation and other models go on."""
+        """``method(argument)``; a plugin that raises is logged once, closed and dropped (None is returned), and
+        the simulation and other models go on."""
         try:
-            method(argument)
+            return method(argument)
         except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
             _logger.error(f"model '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
                           f"{type(error).__name__}: {error}")

@@ -5,7 +5,7 @@ from std_srvs.srv import Empty, EmptyResponse
 
 from ..core.imu import ImuModelPlugin
 from . import RosPlugin, resolve_in_namespace
-from .messages import imu_message
+from .messages import imu_records
 
 
 class GazeboRosImu(RosPlugin, ImuModelPlugin):
@@ -26,4 +26,4 @@ class GazeboRosImu(RosPlugin, ImuModelPlugin):
             self.idle(now)
             return
         super().update(now)
-        self.publisher.publish(imu_message(self.latest, self.frame_name))
+        self.publisher.publish_records(imu_records(self.readings, self.frame_name))
