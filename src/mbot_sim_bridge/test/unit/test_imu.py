@@ -143,6 +143,28 @@ def test_every_step_imu_reads_each_step_without_stopping_the_loop(mbot_urdf, tmp
         single[0].close()
 
 
+def test_every_step_imu_is_read_again_soon_after_reset_simulation(mbot_urdf, tmp_path):
+    """Read, unread, read, as the ROS layer calls it while /imu is subscribed or not, across reset_simulation
+    (sim time back to 0): once read again, the readings start within IDLE_PERIOD."""
+    sim, spawned = spawn(tmp_path, every_step_imu(mbot_urdf, "imu_link"))
+    try:
+        imu = plugin_of(spawned, ImuModelPlugin)
+        listened = [False]
+        update = imu.update
+        imu.update = lambda now: update(now) if listened[0] else imu.idle(now)
+        for read, steps in ((False, 2000), (True, 100), ("reset", 0), (False, 10), (True, 100)):
+            if read == "reset":
+                sim.reset(True)
+            else:
+                listened[0] = read
+                sim.step(steps)
+        assert sim.sim_time == pytest.approx(0.11)
+        assert imu.readings.stamps[-1] == pytest.approx(sim.sim_time)
+        assert len(imu.readings.stamps) < 20  # recording again, in batches
+    finally:
+        sim.close()
+
+
 def test_p3d_equals_the_world_pose(mbot_urdf, tmp_path):
     sim, spawned = spawn(tmp_path, with_imu(mbot_urdf))
     try:

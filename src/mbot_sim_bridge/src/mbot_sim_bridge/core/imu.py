@@ -172,6 +172,7 @@ class ImuModelPlugin(Plugin):
 
     def reset(self, now: float):
         super().reset(now)
+        self._stopping_timer.reset(now)  # also when recording: reset_simulation takes sim time back to 0
         self._rows.clear()
         self._last_velocity = np.asarray(self.context.robot.link_world_velocity(self.link)[0], dtype=float)
         self._last_time = now
@@ -182,9 +183,7 @@ class ImuModelPlugin(Plugin):
         self._recording = False
         self._rows.clear()
         self.timer = self._stopping_timer
-        if self.timer.period < IDLE_PERIOD:
-            self.timer.period = IDLE_PERIOD
-            self.timer.reset(now)
+        self.timer.period = max(self.period, IDLE_PERIOD)
 
     def update(self, now: float):
         if not self._rows:  # the first reading after idle, or a rate below the physics rate: the state now
