@@ -199,6 +199,16 @@ def test_bad_imu_and_p3d_tags_are_refused_with_the_tag(mbot_urdf, tmp_path):
         bad = with_imu(mbot_urdf).replace("<updateRate>50</updateRate>", "<updateRate>-1</updateRate>")
         with pytest.raises(ConfigError, match="updateRate"):
             sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        # A noise whose variance (the covariance diagonals) overflows a float is refused, for each plugin.
+        for plugin in ("imu_plugin", "imu_sensor", "ground_truth"):
+            start = with_imu(mbot_urdf).index(f'<plugin name="{plugin}"')
+            bad = with_imu(mbot_urdf)
+            end = bad.index("</plugin>", start)
+            block = bad[start:end]
+            noisy = (block.replace("<gaussianNoise>0.0</gaussianNoise>", "<gaussianNoise>1e308</gaussianNoise>")
+                     if "gaussianNoise" in block else block + "<gaussianNoise>1e308</gaussianNoise>")
+            with pytest.raises(ConfigError, match="gaussianNoise.*1e308"):
+                sim.spawn_robot(parse_robot(bad[:start] + noisy + bad[end:], "model 'mbot'"), "mbot")
         assert "mbot" not in sim.model_names()
     finally:
         sim.close()

@@ -41,7 +41,7 @@ from .errors import ConfigError
 from .geometry import (IDENTITY, Pose, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrices,
                        rotation_matrix)
 from .log import get_logger, warn_once
-from .params import Param, PluginParams, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, PluginParams, non_negative
 from .plugin import Plugin
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
 from .xml_values import parse_floats
@@ -122,7 +122,7 @@ class ImuModelPlugin(Plugin):
         Param("serviceName", str, "/default_imu", "std_srvs/Empty calibrate service (does nothing)",
               warn_if_missing=False),
         non_negative("gaussianNoise", float, 0.0, "stddev on rates and accelerations; covariance diagonals",
-                     warn_if_missing=False),
+                     warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, no effect in Gazebo", warn_if_missing=False),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation", warn_if_missing=False),
         non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
@@ -265,7 +265,8 @@ class ImuSensor(Plugin):
         Param("topicName", str, "imu_data", "sensor_msgs/Imu, relative to the namespace"),
         Param("frameName", str, None, "frame_id", required=True),
         non_negative("updateRateHZ", float, 1.0, "Hz; publishes no faster than this; 0 = every sensor update"),
-        non_negative("gaussianNoise", float, 0.0, "stddev on every field; covariance diagonals"),
+        non_negative("gaussianNoise", float, 0.0, "stddev on every field; covariance diagonals",
+                     maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, unused by Gazebo"),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation"),
         Param("initialOrientationAsReference", bool, False, "true is deprecated and not emulated",
