@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """A third-party Gazebo robot package (tests/third_party, TurtleBot3's layout), launched unchanged: its world's
-model comes through the package's gazebo_model_path export, /scan sees it, /odom and TF flow, /cmd_vel drives."""
+model comes through the package's gazebo_model_path export, /scan sees it, /odom and TF flow, /cmd_vel drives,
+and TurtleBot3's IMU block gives /imu a message for every 1 ms step."""
 import math
 import threading
 import unittest
@@ -10,7 +11,7 @@ import rostest
 import tf2_ros
 from geometry_msgs.msg import Twist, Vector3
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import Imu, LaserScan
 
 from sim_support import Simulator, wait_for
 
@@ -63,6 +64,23 @@ class ThirdPartyWorld(unittest.TestCase):
         self.sim.cmd_vel.publish(Twist(linear=Vector3(x=0.2)))
         wait_for(lambda: self.latest(self.odom).pose.pose.position.x > SPAWN_X + 0.2, what="the robot to drive")
         self.sim.cmd_vel.publish(Twist())
+
+    def test_3_imu_at_every_step(self):
+        received = []
+        subscriber = rospy.Subscriber("/imu", Imu, received.append)  # an unbounded queue: none dropped
+        wait_for(lambda: len(received) >= 500, what="500 /imu messages")
+        subscriber.unregister()
+        stamps = [message.header.stamp.to_sec() for message in received[:500]]
+        gaps = {round(b - a, 6) for a, b in zip(stamps, stamps[1:])}
+        at_rest = received[-1]
+        print(f"figure: minibot /imu (TurtleBot3's block, updateRate 0): 500 messages, gaps between stamps "
+              f"{sorted(gaps)} s, frame {at_rest.header.frame_id}, linear_acceleration.z "
+              f"{at_rest.linear_acceleration.z:.4f}")
+        self.assertEqual(gaps, {0.001}, "a message for every 1 ms step, none missing")
+        self.assertEqual(at_rest.header.frame_id, "base_footprint")  # sdformat renames the lumped imu_link
+        self.assertLess(abs(at_rest.orientation.z), 0.01)  # spawned facing +x
+        self.assertEqual([message.header.seq for message in received[:500]],
+                         list(range(received[0].header.seq, received[0].header.seq + 500)))
 
 
 if __name__ == "__main__":
