@@ -128,6 +128,20 @@ def main():
         print(f"figure: a dead writer is reported: {error}")
     loop_publishing.stop()
 
+    # Without a writer process, records go out through rospy's own publisher.
+    direct = loop_publishing.LoopPublisher("/imu_direct", Imu)
+    received = []
+    rospy.Subscriber("/imu_direct", Imu, received.append)
+    wait_until(lambda: direct.get_num_connections() == 1, "the connection to /imu_direct")
+    readings = ImuReadings(np.array([0.5, 0.501]), np.array([[0.0, 0.0, 0.0, 1.0]] * 2), np.ones((2, 3)),
+                           np.zeros((2, 3)), 0.0)
+    direct.publish_records(imu_records(readings, "imu_link"))
+    wait_until(lambda: len(received) == 2, "two /imu_direct messages")
+    if [message.header.stamp.to_sec() for message in received] != [0.5, 0.501] or \
+            received[1].angular_velocity.z != 1.0 or received[1].header.frame_id != "imu_link":
+        sys.exit(f"records published without a writer arrived wrong: {received}")
+    print("figure: without a writer process, records are published through rospy and arrive whole")
+
 
 if __name__ == "__main__":
     main()

@@ -13,4 +13,4 @@ def test_loop_publishing_writes_through_the_writer_process(ros_env):
     result = run([sys.executable, NODE], ros_env, timeout=60)
     print(result.stdout)
     assert result.returncode == 0, result.stdout + result.stderr
-    assert result.stdout.count("figure:") == 7
+    assert result.stdout.count("figure:") == 8

@@ -2,7 +2,7 @@
 
 PyBullet's module-level transform helpers are pure functions (they need no physics client), so they are
 used here instead of hand-written quaternion maths. For arrays of poses (a step recording) they would cost a
-call per row; the two array forms below are written out in numpy instead, as scipy's Rotation would cost the
+call per row; the array forms at the end are written out in numpy instead, as scipy's Rotation would cost the
 simulator half a second of start-up to import.
 """
 from typing import NamedTuple, Sequence, Tuple
@@ -53,7 +53,6 @@ def rotate(orientation: Sequence[float], vector: Sequence[float]) -> Tuple[float
     """``vector`` rotated by the quaternion ``orientation``."""
     position, _ = pybullet.multiplyTransforms((0.0, 0.0, 0.0), orientation, vector, (0.0, 0.0, 0.0, 1.0))
     return tuple(position)
-
 
 
 # The array forms work on a batch of a few rows, where numpy's cost per call outweighs its arithmetic; so each
