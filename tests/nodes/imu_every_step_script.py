@@ -36,6 +36,7 @@ def check(condition, what):
 
 
 def steps_and_messages(sim, recorder, steps):
+    sim.settle()  # earlier steps' messages are written but may not all be read yet
     recorder.clear()
     sim_time = sim.step(steps)
     sim.settle()
