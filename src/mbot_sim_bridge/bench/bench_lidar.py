@@ -2,7 +2,8 @@
 
 The world is a 10 m × 10 m walled room with a few boxes and a robot-sized body carrying the sensor, whose
 collision group is filtered out as the bridge does. Prints the median, mean and 95th percentile of a full
-LaserScanner.scan(), then the median of the bare rayTestBatch call inside it, one figure per line.
+LaserScanner.scan(), the median of the bare rayTestBatch call inside it, and ten scans' rays cast one call per
+scan against one call for all, one figure per line.
 
     PYTHONPATH=src/mbot_sim_bridge/src .venv/bin/python src/mbot_sim_bridge/bench/bench_lidar.py
 """
@@ -89,12 +90,37 @@ def main():
         start = time.perf_counter()
         client.rayTestBatch(starts, ends)
         ray_seconds[i] = time.perf_counter() - start
+    separate, together = ten_sensors_cast(client, poses, directions)
     client.disconnect()
     beams = RPLIDAR.range_count
     print(f"lidar scan ({beams} beams) median: {np.median(seconds) * 1e3:.3f} ms")
     print(f"lidar scan ({beams} beams) mean: {seconds.mean() * 1e3:.3f} ms")
     print(f"lidar scan ({beams} beams) p95: {np.percentile(seconds, 95) * 1e3:.3f} ms")
     print(f"rayTestBatch alone ({beams} rays) median: {np.median(ray_seconds) * 1e3:.3f} ms")
+    print(f"ten lidars' rays, one rayTestBatch per lidar, median: {separate * 1e3:.3f} ms")
+    print(f"ten lidars' rays in one rayTestBatch, median: {together * 1e3:.3f} ms")
+
+
+def ten_sensors_cast(client, poses, directions):
+    """Median seconds to cast ten sensors' rays (ten robots' lidars due at the same step), one call per sensor
+    against one call for all: what batching every robot's rays into one call would save."""
+    rounds = len(poses) // 10
+    starts, ends = [], []
+    for pose in poses:
+        rotation = np.asarray(rotation_matrix(pose.orientation))
+        starts.append(directions * RPLIDAR.range_min @ rotation.T + pose.position)
+        ends.append(directions * RPLIDAR.range_max @ rotation.T + pose.position)
+    separate, together = np.empty(rounds), np.empty(rounds)
+    for i in range(rounds):
+        group = slice(10 * i, 10 * i + 10)
+        start = time.perf_counter()
+        for ray_starts, ray_ends in zip(starts[group], ends[group]):
+            [hit[2] for hit in client.rayTestBatch(ray_starts, ray_ends)]
+        separate[i] = time.perf_counter() - start
+        start = time.perf_counter()
+        [hit[2] for hit in client.rayTestBatch(np.concatenate(starts[group]), np.concatenate(ends[group]))]
+        together[i] = time.perf_counter() - start
+    return np.median(separate), np.median(together)
 
 
 if __name__ == "__main__":

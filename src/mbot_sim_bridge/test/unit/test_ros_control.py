@@ -348,3 +348,88 @@ def test_a_joint_commanded_past_its_soft_limit_stops_at_it(interface, controller
         assert final == pytest.approx(SOFT_UPPER, abs=0.005 if interface == "Position" else 0.05)
     finally:
         sim.close()
+
+
+# -- the loop's batches ------------------------------------------------------------------------------------------
+def driven_mbot(urdf):
+    """The mbot with both controllers started at its first step (the switch waits by stepping), driving a circle."""
+    sim, spawned, plugin = simulate(urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+    manager = plugin.manager
+    names = ["joint_state_controller", "mobile_base_controller"]
+    for name in names:
+        assert manager.load(name, plugin.urdf)
+
+    def step_until(done, timeout):
+        while not done.is_set():
+            sim.step(1)
+        return True
+    assert manager.switch(names, [], 2, wait=step_until)
+    drive = manager.find("mobile_base_controller").controller
+    drive.set_command(0.3, 0.5, sim.sim_time)
+    return sim, spawned, plugin, drive
+
+
+def test_controllers_update_between_the_steps_of_a_batch_as_single_steps_would(mbot_ros_control_urdf):
+    """The controllers run on every step inside the loop's batches, and the loop stops only where one publishes:
+    1,000 steps in one call publish at the same steps and end bit for bit where 1,000 single steps do."""
+    runs = []
+    for batch in (1, 1000):
+        sim, spawned, plugin, drive = driven_mbot(mbot_ros_control_urdf)
+        try:
+            published, batches = [], []
+            update, engine_step = plugin.update, sim.engine.step
+
+            def record_update(now, update=update, plugin=plugin, published=published):
+                published.append((now, sorted(loaded.name for loaded in plugin.publish_now)))
+                update(now)
+
+            def record_batch(count, after_each=(), engine_step=engine_step, batches=batches):
+                batches.append(count)
+                engine_step(count, after_each)
+            plugin.update, sim.engine.step = record_update, record_batch
+            for _ in range(1000 // batch):
+                sim.step(batch)
+            runs.append((published, batches, sim.engine.model_pose("mbot"),
+                         (drive.odometry.x, drive.odometry.y, drive.odometry.heading)))
+        finally:
+            sim.close()
+    (single_published, single_batches, single_pose, single_odometry), (published, batches, pose, odometry) = runs
+    assert sum(batches) == sum(single_batches) == 1000
+    assert len(single_batches) == 1000 and len(batches) <= 200, batches
+    assert published == single_published
+    for name in ("joint_state_controller", "mobile_base_controller"):  # 50 Hz each
+        assert 49 <= sum(name in names for _, names in published) <= 51
+    assert pose == single_pose and odometry == single_odometry
+    assert odometry[2] > 0.2  # it turned (0.5 rad/s until cmd_vel_timeout, 0.5 s)
+
+
+def test_a_controller_plugin_failing_within_a_batch_is_disabled_for_the_rest_of_it(mbot_ros_control_urdf, caplog):
+    sim, spawned, plugin, drive = driven_mbot(mbot_ros_control_urdf)
+    try:
+        calls = []
+
+        def fail(step_size):
+            calls.append(sim.sim_time)
+            raise RuntimeError("broken")
+        plugin.on_step = fail
+        with caplog.at_level(logging.ERROR):
+            sim.step(500)
+        assert len(calls) == 1 and plugin not in spawned.plugins
+        assert caplog.text.count("plugin GazeboRosControlPlugin(ns = /) failed and is disabled") == 1
+        assert sim.sim_time == pytest.approx(0.501)
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("rate", [0, math.nan])
+def test_a_publish_rate_without_a_period_refuses_the_diff_drive_controller(mbot_ros_control_urdf, rate, caplog):
+    params = load_yaml(MBOT_YAML)
+    params["mobile_base_controller"]["publish_rate"] = rate
+    sim, _, plugin = simulate(mbot_ros_control_urdf, params, "mbot", namespace="/")
+    try:
+        assert not plugin.manager.load("mobile_base_controller", plugin.urdf)
+        assert f"publish_rate {float(rate)} gives no publish period" in caplog.text
+        assert start_controllers(sim, plugin, "joint_state_controller")
+        sim.step(100)
+    finally:
+        sim.close()

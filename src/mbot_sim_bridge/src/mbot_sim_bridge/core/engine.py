@@ -268,17 +268,19 @@ class Engine:
         return self.steps * self.physics.max_step_size
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
-        """``count`` physics steps; ``after_each`` (recorders of per-step state) is called after every one."""
+        """``count`` physics steps; each of ``after_each`` (recorders of per-step state, then the plugins that act
+        on every step) is called after every one, with ``sim_time`` already that step's."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
         if after_each:
             for _ in range(count):
                 step()
-                for record in after_each:
-                    record()
+                self.steps += 1
+                for call in after_each:
+                    call()
         else:
             for _ in range(count):
                 step()
-        self.steps += count
+            self.steps += count
 
     def add_world(self, world: LoadedWorld):
         """Register the bodies a world loader built, so reset and model queries know them."""

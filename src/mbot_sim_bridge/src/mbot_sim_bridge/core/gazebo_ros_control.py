@@ -8,8 +8,10 @@ from ``robotParam``, the parameters, the controllers' ROS classes and the servic
 
 The controllers' messages are published from ``update(now)``, which the Simulation calls after /clock
 (``timer`` is due whenever a running controller's publish time has come), so none is stamped ahead of the
-clock; their control runs in ``on_step``.
+clock; their control runs in ``on_step``, between the physics steps of a batch, so the loop stops only where a
+controller publishes (``Controller.steps_until_publish``).
 """
+import sys
 from typing import List
 
 from . import names
@@ -58,7 +60,9 @@ class _PublishSchedule:
         return bool(due)
 
     def steps_until_due(self, now: float, step_size: float) -> int:
-        return 1  # the plugin steps with the physics anyway (needs_every_step)
+        # Controllers started within a batch are counted from the next stop (a first message that much later).
+        return min([loaded.controller.steps_until_publish(now, step_size) for loaded in self.plugin.manager.controllers
+                    if loaded.controller.state == "running"], default=sys.maxsize)
 
     def reset(self, now: float):
         pass
@@ -137,8 +141,9 @@ class GazeboRosControlPlugin(Plugin):
         self.hw.e_stop_active = self.e_stop
         period = now - self.last_update
         if period >= self.control_period - _EPSILON:
+            if not self.hw.read_sim():
+                return
             self.last_update = now
-            self.hw.read_sim()
             reset = False
             if self.e_stop:
                 self._last_e_stop = True

@@ -113,7 +113,8 @@ class Plugin:
         return tuple(params[tag] for tag in tags)
 
     def on_step(self, step_size: float):
-        """After every physics step, when ``needs_every_step``."""
+        """After every physics step, when ``needs_every_step``: between the steps of a batch (``sim_time`` is
+        that step's), so it does not stop the loop; what it makes for ROS waits for ``update``."""
 
     def step_recorder(self, now: float) -> Optional[Callable[[], None]]:
         """Before the loop steps: a call to make after each of its physics steps (it should only read state,

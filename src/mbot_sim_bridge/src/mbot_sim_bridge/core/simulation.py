@@ -304,9 +304,8 @@ class Simulation:
 
     # -- stepping ------------------------------------------------------------------------------------------------
     def steps_to_next_event(self) -> int:
-        """Physics steps until the next plugin timer can be due (1 when a plugin needs every step)."""
-        if self._every_step:
-            return 1
+        """Physics steps until the next plugin timer can be due. Plugins that act on every step do so between the
+        steps of a batch, so they do not end it."""
         now, step = self.sim_time, self.step_size
         batch = max(1, int(round(MAX_BATCH_SIM_SECONDS / step)))
         wrench_steps = self.wrenches.steps_until_next(now, step)
@@ -320,12 +319,12 @@ class Simulation:
         if self.wrenches.pending() or self.wrenches.applied:
             self._apply_wrenches()
         recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
-        self.engine.step(count, [recorder for recorder in recorders if recorder is not None])
+        per_step = [recorder for recorder in recorders if recorder is not None]
+        per_step += [self._every_step_call(plugin) for plugin in self._every_step]
+        self.engine.step(count, per_step)
         broken = self.engine.robots_not_finite()
         if broken:
             self._freeze(broken)
-        for plugin in self._every_step:
-            self._guarded(plugin, plugin.on_step, self.step_size)
         now = self.sim_time
         due = [plugin for plugin in self._plugins if plugin.timer.due(now)]
         if before_updates is not None:
@@ -360,6 +359,16 @@ class Simulation:
         """Exactly ``count`` physics steps, with every plugin event on the way."""
         while count > 0:
             count -= self.advance(count, before_updates)
+
+    def _every_step_call(self, plugin: Plugin) -> Callable[[], None]:
+        """``plugin.on_step`` as a call for ``Engine.step`` to make after every step of a batch; after a failure
+        (the plugin is then disabled) the rest of the batch skips it."""
+        step_size, model = self.step_size, plugin.context.model
+
+        def on_step():
+            if plugin in model.plugins:  # a failed plugin is removed from its model's few
+                self._guarded(plugin, plugin.on_step, step_size)
+        return on_step
 
     def _guarded(self, plugin: Plugin, method, argument):
         """``method(argument)``; a plugin that raises is logged once, closed and dropped (None is returned), and

@@ -78,6 +78,9 @@ class RosDiffDriveController(DiffDriveController):
         self._odometry_due = odometry_due
         return odometry_due or self._cmd_pending
 
+    def steps_until_publish(self, now, step_size):
+        return 1 if self.cmd_publisher is not None else super().steps_until_publish(now, step_size)
+
     def publish(self, stamp):
         if self._cmd_pending:
             self._cmd_pending = False

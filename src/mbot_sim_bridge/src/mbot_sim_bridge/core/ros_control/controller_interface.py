@@ -31,6 +31,13 @@ def param(params: dict, path: str, default=_MISSING, kind: type = float, where: 
     return None if default is _MISSING else default
 
 
+def steps_until_past(deadline: float, now: float, step_size: float) -> int:
+    """Physics steps until sim time first exceeds ``deadline`` (a rate publisher's ``last + period < now``),
+    counted so that rounding can only make it one short: stopping a step early costs a stop, stepping past the
+    deadline would delay the message."""
+    return max(1, math.floor((deadline - now) / step_size - 1e-6) + 1)
+
+
 class Controller:
     """controller_interface::Controller<T>: the state machine and the claimed resources."""
 
@@ -79,6 +86,11 @@ class Controller:
     def publish_due(self, now: float) -> bool:
         """Whether the ROS layer has something to publish now (the bridge publishes after /clock)."""
         return False
+
+    def steps_until_publish(self, now: float, step_size: float) -> int:
+        """Physics steps until ``publish_due`` can next be true, so that the loop stops there; 1 (every step) for
+        a controller whose updates can make something to publish at any step."""
+        return 1
 
     def restart_clock(self, now: float):
         """Sim time was reset: start the publish and timeout clocks again from ``now``."""

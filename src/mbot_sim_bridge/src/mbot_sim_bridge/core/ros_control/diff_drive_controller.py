@@ -11,7 +11,7 @@ from ..robot_model import RobotModel
 from .control_toolbox import clamp
 from .controller_manager import ControllerInitError
 from .hardware_interface import VELOCITY
-from .controller_interface import Controller, param
+from .controller_interface import Controller, param, steps_until_past
 
 _logger = get_logger(__name__)
 
@@ -160,6 +160,9 @@ class DiffDriveController(Controller):
         def get(key, default, kind=float):
             return param(params, key, default, kind, name)
         self.publish_rate = get("publish_rate", 50.0)
+        if math.isnan(self.publish_rate) or self.publish_rate == 0:  # upstream's Duration(1 / rate) throws
+            raise ControllerInitError(f"publish_rate {self.publish_rate} gives no publish period; it must be a "
+                                      "number other than 0")
         self.open_loop = get("open_loop", False, bool)
         self.wheel_separation_multiplier = get("wheel_separation_multiplier", 1.0)
         if "wheel_radius_multiplier" in params:
@@ -289,3 +292,6 @@ class DiffDriveController(Controller):
             self.last_publish += 1.0 / self.publish_rate
             return True
         return False
+
+    def steps_until_publish(self, now, step_size):
+        return steps_until_past(self.last_publish + 1.0 / self.publish_rate, now, step_size)

@@ -1,11 +1,12 @@
 """joint_state_controller/JointStateController: ``publish_rate`` (required), ``joints``, ``extra_joints``. The ROS
 layer (``plugins/ros_controllers.py``) publishes."""
+import sys
 from typing import List
 
 from ..log import get_logger
 from .controller_manager import ControllerInitError
 from .hardware_interface import JOINT_STATE
-from .controller_interface import Controller, param
+from .controller_interface import Controller, param, steps_until_past
 
 _logger = get_logger(__name__)
 
@@ -72,6 +73,11 @@ class JointStateController(Controller):
             self.last_publish += 1.0 / self.publish_rate
             return True
         return False
+
+    def steps_until_publish(self, now, step_size):
+        if not self.publish_rate > 0:  # NaN included: it never publishes
+            return sys.maxsize
+        return steps_until_past(self.last_publish + 1.0 / self.publish_rate, now, step_size)
 
     def states(self):
         """(names, positions, velocities, efforts) with the extra joints' fixed values last."""

@@ -152,17 +152,25 @@ class DefaultRobotHWSim:
     def names_with(self, interface: str) -> List[str]:
         return [name for name, joint in self.joints.items() if interface == JOINT_STATE or joint.interface == interface]
 
-    def read_sim(self):
-        """readSim: positions (revolute and continuous unwrapped step by step, as upstream), velocities, efforts."""
+    def read_sim(self) -> bool:
+        """readSim: positions (revolute and continuous unwrapped step by step, as upstream), velocities, efforts.
+        False, with nothing read, when the physics made the model's state NaN: the Simulation freezes the model
+        once the batch of steps ends, and the controllers must not carry the NaN past a reset."""
         if not self.names:
-            return
-        for joint, (position, velocity, effort) in zip(self.joints.values(), self.robot.joint_state(self.names)):
+            return True
+        states = self.robot.joint_state(self.names)
+        # One sum in C instead of a test per value: finite states cannot overflow it (efforts and speeds are
+        # bounded far below the float range), so a non-finite sum means a NaN or inf in the state.
+        if not math.isfinite(sum(map(sum, states))):
+            return False
+        for joint, (position, velocity, effort) in zip(self.joints.values(), states):
             if joint.joint_type == "prismatic":
                 joint.position = position
             else:
                 joint.position += shortest_angular_distance(joint.position, position)
             joint.velocity = velocity
             joint.effort = effort
+        return True
 
     def write_sim(self, period: float):
         """writeSim: e-stop, limit saturation, then each joint's motor; the engine is told only of changes."""
