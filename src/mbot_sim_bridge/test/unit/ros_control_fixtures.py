@@ -54,6 +54,26 @@ def switch(sim, manager, start=(), stop=(), strictness=2):
     return result[0]
 
 
+def switch_stepping(sim, manager, start):
+    """Start the controllers ``start`` at the very next step, deterministically: the switch waits by stepping."""
+    def step_until(done, timeout):
+        while not done.is_set():
+            sim.step(1)
+        return True
+    assert manager.switch(list(start), [], 2, wait=step_until)
+
+
+def recording_batches(sim):
+    """The step counts of the loop's batches, recorded from now on."""
+    batches, engine_step = [], sim.engine.step
+
+    def record(count, after_each=()):
+        batches.append(count)
+        engine_step(count, after_each)
+    sim.engine.step = record
+    return batches
+
+
 def expand_xacro_arm(interface):
     import xacro_noetic as xacro
     return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),

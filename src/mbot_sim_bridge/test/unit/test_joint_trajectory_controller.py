@@ -3,7 +3,8 @@
 import math
 
 import pytest
-from ros_control_fixtures import expand_xacro_arm, run_until_ended, simulate, start_controllers, switch
+from ros_control_fixtures import (expand_xacro_arm, recording_batches, run_until_ended, simulate, start_controllers,
+                                  switch, switch_stepping)
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
@@ -217,3 +218,41 @@ def test_bad_numbers_in_a_goals_tolerances_and_in_query_state_move_nothing(value
             break
     assert [joint.position for joint in controller.joints] == pytest.approx([0.2, 0.2], abs=0.01)
     assert controller.query_state(value) is None or math.isfinite(value)
+
+
+def test_the_trajectory_controller_updates_between_the_steps_of_a_batch_as_single_steps_would():
+    """1,500 steps in one call against one at a time, published as the ROS layer does (each stop takes what is due):
+    the state (50 Hz) and feedback (20 Hz) go out at the same steps with the same values, the arm ends bit for bit
+    alike, and the goal's end goes out at the next stop, within 10 ms of sim time."""
+    config = {"type": "position_controllers/JointTrajectoryController", "joints": JOINTS,
+              "constraints": {"goal_time": 0.5, "shoulder": {"goal": 0.01}, "elbow": {"goal": 0.01}}}
+    runs = []
+    for batch in (1, 1500):
+        sim, _, plugin = simulate(expand_xacro_arm("Position"), {"arm_controller": config}, "arm")
+        try:
+            assert plugin.manager.load("arm_controller", plugin.urdf)
+            switch_stepping(sim, plugin.manager, ["arm_controller"])
+            controller = plugin.manager.find("arm_controller").controller
+            outputs, ends, batches = [], [], recording_batches(sim)
+
+            def publish(now, controller=controller, outputs=outputs, ends=ends):
+                if controller.state_due or controller.feedback_due:
+                    outputs.append((now, controller.state_due, controller.feedback_due, controller.desired,
+                                    controller.actual))
+                ends.extend((now, end.status) for end in controller.ended)
+                controller.state_due = controller.feedback_due = False
+                controller.ended.clear()
+            plugin.update = publish
+            assert controller.accept_goal(goal([(0.6, [0.3, -0.4]), (1.0, [0.6, -0.9])]))[0]
+            for _ in range(1500 // batch):
+                sim.step(batch)
+            runs.append((outputs, ends, batches, [joint.position for joint in controller.joints]))
+        finally:
+            sim.close()
+    (single_outputs, single_ends, single_batches, single_end), (outputs, ends, batches, end) = runs
+    assert len(single_batches) == 1500 and len(batches) <= 300, batches
+    assert outputs == single_outputs
+    assert sum(feedback for _, _, feedback, _, _ in outputs) >= 20  # 20 Hz while the goal runs
+    assert end == single_end
+    [(single_time, single_status)], [(time, status)] = single_ends, ends
+    assert status == single_status == SUCCEEDED and single_time <= time <= single_time + 0.01 + 1e-9

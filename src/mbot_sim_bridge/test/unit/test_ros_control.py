@@ -16,8 +16,8 @@ from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
 from mbot_sim_bridge.core.xml_values import parse_xml
 
 from conftest import expand_xacro
-from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, measured_motion, simulate,
-                                  start_controllers, switch)
+from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, measured_motion,
+                                  recording_batches, simulate, start_controllers, switch, switch_stepping)
 
 
 @pytest.fixture(scope="module")
@@ -358,12 +358,7 @@ def driven_mbot(urdf):
     names = ["joint_state_controller", "mobile_base_controller"]
     for name in names:
         assert manager.load(name, plugin.urdf)
-
-    def step_until(done, timeout):
-        while not done.is_set():
-            sim.step(1)
-        return True
-    assert manager.switch(names, [], 2, wait=step_until)
+    switch_stepping(sim, manager, names)
     drive = manager.find("mobile_base_controller").controller
     drive.set_command(0.3, 0.5, sim.sim_time)
     return sim, spawned, plugin, drive
@@ -376,17 +371,12 @@ def test_controllers_update_between_the_steps_of_a_batch_as_single_steps_would(m
     for batch in (1, 1000):
         sim, spawned, plugin, drive = driven_mbot(mbot_ros_control_urdf)
         try:
-            published, batches = [], []
-            update, engine_step = plugin.update, sim.engine.step
+            published, batches, update = [], recording_batches(sim), plugin.update
 
             def record_update(now, update=update, plugin=plugin, published=published):
                 published.append((now, sorted(loaded.name for loaded in plugin.publish_now)))
                 update(now)
-
-            def record_batch(count, after_each=(), engine_step=engine_step, batches=batches):
-                batches.append(count)
-                engine_step(count, after_each)
-            plugin.update, sim.engine.step = record_update, record_batch
+            plugin.update = record_update
             for _ in range(1000 // batch):
                 sim.step(batch)
             runs.append((published, batches, sim.engine.model_pose("mbot"),

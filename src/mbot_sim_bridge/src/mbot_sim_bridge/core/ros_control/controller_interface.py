@@ -1,5 +1,6 @@
 """controller_interface::Controller<T>, and reading a controller's parameters as NodeHandle::param does."""
 import math
+import sys
 from typing import List, Sequence
 
 from ..log import get_logger, warn_once
@@ -35,7 +36,10 @@ def steps_until_past(deadline: float, now: float, step_size: float) -> int:
     """Physics steps until sim time first exceeds ``deadline`` (a rate publisher's ``last + period < now``),
     counted so that rounding can only make it one short: stopping a step early costs a stop, stepping past the
     deadline would delay the message."""
-    return max(1, math.floor((deadline - now) / step_size - 1e-6) + 1)
+    remaining = (deadline - now) / step_size
+    if not math.isfinite(remaining):  # a deadline of -inf (publish at once) or +inf (never); NaN: every step
+        return sys.maxsize if remaining > 0 else 1
+    return max(1, math.floor(remaining - 1e-6) + 1)
 
 
 class Controller:
@@ -88,9 +92,10 @@ class Controller:
         return False
 
     def steps_until_publish(self, now: float, step_size: float) -> int:
-        """Physics steps until ``publish_due`` can next be true, so that the loop stops there; 1 (every step) for
-        a controller whose updates can make something to publish at any step."""
-        return 1
+        """Physics steps until ``publish_due`` can next be true: the loop runs the updates between the steps of
+        its batches and stops there. A controller that publishes says when; what an update makes at any step (a
+        goal's end) goes out when the loop next stops."""
+        return sys.maxsize
 
     def restart_clock(self, now: float):
         """Sim time was reset: start the publish and timeout clocks again from ``now``."""

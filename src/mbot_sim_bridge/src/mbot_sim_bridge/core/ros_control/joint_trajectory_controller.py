@@ -13,6 +13,7 @@ threads, the update in the loop thread: ``lock`` serialises them.
 """
 import copy
 import math
+import sys
 import threading
 from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
@@ -20,7 +21,7 @@ from typing import List, Optional, Sequence, Tuple
 from ..log import get_logger, warn_once
 from .angles import shortest_angular_distance
 from .control_toolbox import Pid
-from .controller_interface import Controller, param
+from .controller_interface import Controller, param, steps_until_past
 from .controller_manager import ControllerInitError
 from .hardware_interface import POSITION
 
@@ -577,3 +578,18 @@ class JointTrajectoryController(Controller):
 
     def publish_due(self, now):
         return self.state_due or self.feedback_due or bool(self.ended)
+
+    def steps_until_publish(self, now, step_size):
+        # The state at state_publish_rate of controller uptime, the feedback at action_monitor_rate while a goal
+        # is active; a goal's end waits for the next stop, as upstream's waits for its action monitor timer.
+        with self.lock:
+            if self.publish_due(now):
+                return 1
+            steps = sys.maxsize
+            if self.state_publish_period > 0.0:
+                steps = steps_until_past(self._last_state_publish + self.state_publish_period, self.uptime,
+                                         step_size)
+            if self.active_goal is not None and self.action_monitor_period > 0.0:
+                steps = min(steps, steps_until_past(self._last_feedback + self.action_monitor_period - 1e-9,
+                                                    self.time, step_size))
+            return steps

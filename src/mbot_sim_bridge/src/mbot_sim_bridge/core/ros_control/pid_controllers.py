@@ -81,6 +81,10 @@ class _StateSampling:
     def publish_due(self, now):
         return self.state_sample is not None
 
+    def steps_until_publish(self, now, step_size):
+        # The update that samples is at least that many steps away (exactly, when controlPeriod is the step).
+        return 1 if self.state_sample is not None else (-self.updates) % STATE_EVERY_UPDATES + 1
+
 
 class PidPositionController(_StateSampling, Controller):
     """effort_controllers/JointPositionController (INTERFACE EFFORT) and velocity_controllers/
