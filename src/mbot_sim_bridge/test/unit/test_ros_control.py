@@ -8,7 +8,7 @@ import os
 import pytest
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.ros_control.angles import shortest_angular_distance_with_limits
+from mbot_sim_bridge.core.ros_control.angles import normalize_angle, shortest_angular_distance_with_limits
 from mbot_sim_bridge.core.ros_control.control_toolbox import Pid
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveOdometry, SpeedLimiter
 from mbot_sim_bridge.core.ros_control.joint_limits import JointLimits, apply_limit_params
@@ -87,6 +87,14 @@ def test_shortest_angular_distance_with_limits_takes_the_way_within_them():
 
 
 # -- maths -------------------------------------------------------------------------------------------------------
+def test_normalize_angle_is_upstreams_fmod_into_minus_pi_exclusive_to_pi():
+    assert normalize_angle(math.pi) == normalize_angle(-math.pi) == normalize_angle(3 * math.pi) == math.pi
+    assert normalize_angle(2 * math.pi) == 0.0 and normalize_angle(-2 * math.pi) == 0.0
+    assert normalize_angle(7.0) == 7.0 - 2 * math.pi
+    # Exact where atan2(sin, cos) is not: a wheel that has turned a million radians.
+    assert normalize_angle(1e6) == math.fmod(1e6 + math.pi, 2 * math.pi) - math.pi
+
+
 def test_pid_terms_clamp_and_antiwindup():
     pid = Pid(p=2.0, i=1.0, d=0.5, i_max=0.3, i_min=-0.3)
     # First call: upstream's reset leaves the last error at 0 and "valid", so d sees the whole step.

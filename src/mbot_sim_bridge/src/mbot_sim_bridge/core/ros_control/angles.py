@@ -3,7 +3,9 @@ import math
 
 
 def normalize_angle(angle: float) -> float:
-    return math.atan2(math.sin(angle), math.cos(angle))
+    """Into (-pi, pi], with upstream's fmod (exact, where atan2(sin, cos) rounds)."""
+    result = math.fmod(angle + math.pi, 2 * math.pi)
+    return result + math.pi if result <= 0.0 else result - math.pi
 
 
 def shortest_angular_distance(start: float, end: float) -> float:
