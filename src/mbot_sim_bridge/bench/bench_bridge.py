@@ -3,8 +3,9 @@
 
 (a) raw PyBullet: the course's mbot driven by the core's diff-drive loop in the empty world, no ROS;
 (b) the bridge: mbot_gazebo's mbot_world.launch (the mbot in the empty world) at real-time factor 0 with every
-topic subscribed; the real-time factor of each and their ratio, and the wall time from roslaunch to the first /odom
-(median of several launches);
+topic subscribed; the real-time factor of each and their ratio, the CPU seconds per sim second of every process
+(the bridge, its writer, rosmaster, robot_state_publisher, this subscribing client) and the ratio they leave room
+for, and the wall time from roslaunch to the first /odom (median of several launches);
 then ten robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
 (bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
 """
@@ -14,6 +15,7 @@ import statistics
 import subprocess
 import sys
 import time
+from typing import Dict
 
 import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
@@ -71,8 +73,29 @@ def first_odom_seconds() -> float:
         stop_process_group(launch)
 
 
+# What each process on the machine is, by a word of its command line; this bench is the subscribing client.
+PROCESS_KINDS = (("gzserver", "bridge"), ("wire_writer", "writer"), ("rosmaster", "rosmaster"),
+                 ("robot_state_publisher", "robot_state_publisher"))
+
+
+def cpu_seconds_by_kind() -> Dict[str, float]:
+    """CPU seconds (user and system) used so far by every process on the machine, summed by kind."""
+    tick, mine = os.sysconf("SC_CLK_TCK"), str(os.getpid())
+    totals: Dict[str, float] = {}
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/stat") as stat, open(f"/proc/{pid}/cmdline", "rb") as cmdline:
+                fields, command = stat.read().rsplit(")", 1)[1].split(), cmdline.read().decode(errors="replace")
+        except OSError:  # the process ended meanwhile
+            continue
+        kind = "client" if pid == mine else next((kind for word, kind in PROCESS_KINDS if word in command), "other")
+        totals[kind] = totals.get(kind, 0.0) + (int(fields[11]) + int(fields[12])) / tick
+    return totals
+
+
 def bridge_rtf(wall_seconds: float):
-    """(real-time factor, topics subscribed) of one launch with every topic subscribed."""
+    """(real-time factor, topics subscribed, CPU seconds per sim second by process kind, cores busy) of one
+    launch with every topic subscribed."""
     launch = _launch()
     try:
         rospy.wait_for_message("/odom", Odometry, timeout=120)
@@ -83,12 +106,15 @@ def bridge_rtf(wall_seconds: float):
         subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
                         for topic, _ in rospy.get_published_topics() if topic != "/clock"]
         time.sleep(1.0)  # let every subscription connect before the measured window
-        window_start = len(clock)
+        window_start, cpu_start = len(clock), cpu_seconds_by_kind()
         time.sleep(wall_seconds)
+        cpu_end = cpu_seconds_by_kind()
         (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
         for subscriber in subscribers:
             subscriber.unregister()
-        return (sim1 - sim0) / (wall1 - wall0), len(subscribers)
+        used = {kind: cpu_end[kind] - cpu_start.get(kind, 0.0) for kind in cpu_end}
+        per_sim_second = {kind: seconds / (sim1 - sim0) for kind, seconds in used.items()}
+        return (sim1 - sim0) / (wall1 - wall0), len(subscribers), per_sim_second, sum(used.values()) / (wall1 - wall0)
     finally:
         stop_process_group(launch)
 
@@ -105,9 +131,16 @@ def main():
     with PrivateMaster() as master:
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy and the launches
         rospy.init_node("bench_bridge", disable_signals=True)
-        bridge, topics = bridge_rtf(args.wall_seconds)
+        bridge, topics, cpu, cores_busy = bridge_rtf(args.wall_seconds)
         print(f"bridge real-time factor ({topics} topics subscribed): {bridge:.2f}")
         print(f"bridge / raw: {bridge / raw:.2f}")
+        print(f"CPU seconds per sim second: raw PyBullet {1 / raw:.4f}; "
+              + ", ".join(f"{kind} {seconds:.4f}" for kind, seconds in sorted(cpu.items(), key=lambda kv: -kv[1]))
+              + f"; cores busy {cores_busy:.2f} of {os.cpu_count()}")
+        # The ceiling the other processes leave: a bridge costing what raw PyBullet costs, on every core.
+        beside = sum(seconds for kind, seconds in cpu.items() if kind != "bridge")
+        print(f"bridge / raw at most, with the processes beside the bridge as measured and a bridge costing what "
+              f"raw PyBullet does: {os.cpu_count() / (1 / raw + beside) / raw:.2f}", flush=True)
         # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several.
         launches = sorted(first_odom_seconds() for _ in range(args.launches))
         print(f"roslaunch to first /odom: median {statistics.median(launches):.2f} s ({len(launches)} launches, "
