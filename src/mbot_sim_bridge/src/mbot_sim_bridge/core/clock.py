@@ -48,8 +48,9 @@ class UpdateTimer:
 
 
 class EveryStopTimer:
-    """Due whenever the loop stops for another event, never asking it to stop: the timer of a plugin that
-    records every physics step (``Plugin.step_recorder``) and reports the recorded steps together."""
+    """Due whenever the loop stops for another event, never asking it to stop: the timer of a plugin whose
+    work happens between the physics steps (``Plugin.on_step``, or ``Plugin.step_recorder`` with the recorded
+    steps reported together)."""
 
     period = 0.0
 

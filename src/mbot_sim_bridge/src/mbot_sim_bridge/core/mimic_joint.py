@@ -14,7 +14,7 @@ itself by adding the plugin block a user would write for each mimicking joint no
 import math
 
 from . import names
-from .clock import UpdateTimer
+from .clock import EveryStopTimer
 from .errors import ConfigError
 from .params import ERROR_MODEL_LIMIT, Param, non_negative
 from .plugin import Plugin
@@ -60,7 +60,7 @@ class MimicJoint(Plugin):
                 raise ConfigError(f"{context.where(element)}: {self.label}: hasPID: no usable gains under "
                                   f"{namespace} (p, i, d)")
         self.driven_joints = (self.follower,)
-        self.timer = UpdateTimer(0.0, start=context.simulation.sim_time)
+        self.timer = EveryStopTimer()  # all its work is in on_step: nothing of its own stops the loop
         self.drive(context.simulation.step_size)
 
     def drive(self, step_size: float):
