@@ -1,6 +1,9 @@
+import math
+import sys
+
 import pytest
 
-from mbot_sim_bridge.core.clock import UpdateTimer
+from mbot_sim_bridge.core.clock import UpdateTimer, steps_until_past
 
 STEP = 0.001
 
@@ -40,3 +43,12 @@ def test_reset_restarts_the_period():
     assert timer.due(0.1)
     timer.reset(0.0)
     assert not timer.due(0.05) and timer.due(0.1)
+
+
+def test_steps_until_past_never_steps_past_the_deadline():
+    step = STEP
+    assert steps_until_past(0.0055, 0.0, step) == 6  # the first step after 5.5 steps
+    assert steps_until_past(0.005, 0.0, step) in (5, 6)  # at the boundary a step early is allowed, never later
+    assert steps_until_past(-1.0, 0.0, step) == 1
+    assert steps_until_past(-math.inf, 0.0, step) == steps_until_past(math.nan, 0.0, step) == 1
+    assert steps_until_past(math.inf, 0.0, step) == sys.maxsize

@@ -47,6 +47,16 @@ class UpdateTimer:
         return max(1, whole)
 
 
+def steps_until_past(deadline: float, now: float, step_size: float) -> int:
+    """Physics steps until sim time first exceeds ``deadline`` (a rate publisher's ``last + period < now``),
+    counted so that rounding can only make it one short: stopping a step early costs a stop, stepping past the
+    deadline would delay the message."""
+    remaining = (deadline - now) / step_size
+    if not math.isfinite(remaining):  # a deadline of -inf (publish at once) or +inf (never); NaN: every step
+        return sys.maxsize if remaining > 0 else 1
+    return max(1, math.floor(remaining - 1e-6) + 1)
+
+
 class EveryStopTimer:
     """Due whenever the loop stops for another event, never asking it to stop: the timer of a plugin whose
     work happens between the physics steps (``Plugin.on_step``, or ``Plugin.step_recorder`` with the recorded

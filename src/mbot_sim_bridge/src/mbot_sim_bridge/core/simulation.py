@@ -79,7 +79,7 @@ class Simulation:
         # What was built, in order (a WorldDescription, or the name of a robot), for reset_simulation's rebuild.
         self._build_order: List[object] = []
         self._plugins: List[Plugin] = []
-        self._every_step: List[Plugin] = []
+        self._every_step_calls: List[Callable[[], None]] = []  # on_step of the plugins that need every step
         self._recording: List[Plugin] = []
         self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
@@ -299,7 +299,7 @@ class Simulation:
     def _schedule(self):
         self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
                          for plugin in spawned.plugins]
-        self._every_step = [plugin for plugin in self._plugins if plugin.needs_every_step]
+        self._every_step_calls = [self._every_step_call(plugin) for plugin in self._plugins if plugin.needs_every_step]
         self._recording = [plugin for plugin in self._plugins if type(plugin).step_recorder is not Plugin.step_recorder]
 
     # -- stepping ------------------------------------------------------------------------------------------------
@@ -320,7 +320,7 @@ class Simulation:
             self._apply_wrenches()
         recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
         per_step = [recorder for recorder in recorders if recorder is not None]
-        per_step += [self._every_step_call(plugin) for plugin in self._every_step]
+        per_step += self._every_step_calls
         self.engine.step(count, per_step)
         broken = self.engine.robots_not_finite()
         if broken:

@@ -32,16 +32,6 @@ def param(params: dict, path: str, default=_MISSING, kind: type = float, where: 
     return None if default is _MISSING else default
 
 
-def steps_until_past(deadline: float, now: float, step_size: float) -> int:
-    """Physics steps until sim time first exceeds ``deadline`` (a rate publisher's ``last + period < now``),
-    counted so that rounding can only make it one short: stopping a step early costs a stop, stepping past the
-    deadline would delay the message."""
-    remaining = (deadline - now) / step_size
-    if not math.isfinite(remaining):  # a deadline of -inf (publish at once) or +inf (never); NaN: every step
-        return sys.maxsize if remaining > 0 else 1
-    return max(1, math.floor(remaining - 1e-6) + 1)
-
-
 class Controller:
     """controller_interface::Controller<T>: the state machine and the claimed resources."""
 

@@ -11,7 +11,8 @@ from ..robot_model import RobotModel
 from .control_toolbox import clamp
 from .controller_manager import ControllerInitError
 from .hardware_interface import VELOCITY
-from .controller_interface import Controller, param, steps_until_past
+from ..clock import steps_until_past
+from .controller_interface import Controller, param
 
 _logger = get_logger(__name__)
 

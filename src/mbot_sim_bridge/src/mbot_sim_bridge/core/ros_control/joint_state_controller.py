@@ -6,7 +6,8 @@ from typing import List
 from ..log import get_logger
 from .controller_manager import ControllerInitError
 from .hardware_interface import JOINT_STATE
-from .controller_interface import Controller, param, steps_until_past
+from ..clock import steps_until_past
+from .controller_interface import Controller, param
 
 _logger = get_logger(__name__)
 

@@ -21,7 +21,8 @@ from typing import List, Optional, Sequence, Tuple
 from ..log import get_logger, warn_once
 from .angles import shortest_angular_distance
 from .control_toolbox import Pid
-from .controller_interface import Controller, param, steps_until_past
+from ..clock import steps_until_past
+from .controller_interface import Controller, param
 from .controller_manager import ControllerInitError
 from .hardware_interface import POSITION
 
