@@ -1,11 +1,12 @@
 """``./mbot demo``: the mbot with its lidar tours a world headless, then a picture shows what it saw.
 
-Starts a private ROS master and the course's launch file at the fastest real-time factor the machine
-sustains, drives a scripted tour through /cmd_vel (closed loop on /odom, so distances and turns come out
-the same at any speed), records /odom and /scan (through TF into odom), and writes out/demo.png with a
+Starts a private ROS master and the course's launch file in lockstep, drives a scripted tour through /cmd_vel
+(closed loop on /odom at 20 Hz of sim time, stepping the simulation itself, so the tour is the same on any
+machine and under any load), records /odom and /scan (through TF into odom), and writes out/demo.png with a
 picture of the world, as the course's kinect sees it from the final pose, beside the top view.
 """
 import argparse
+import bisect
 import contextlib
 import logging
 import math
@@ -22,6 +23,7 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.log import c_stdout_to, get_logger
 from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.lockstep import LockstepClient
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
@@ -39,8 +41,11 @@ TOUR = (("forward", 2.2), ("turn", 90), ("forward", 1.0), ("turn", 90), ("forwar
 LINEAR_SPEED, TURN_SPEED, MIN_TURN_SPEED = 0.4, 0.8, 0.1
 HEADING_GAIN = 2.0  # rad/s of command per rad of heading error
 PROGRESS_PERIOD = 0.5  # wall seconds between progress updates (2 s when the output is not a terminal)
+CONTROL_PERIOD = 0.05  # sim seconds between two commands (rounded to whole physics steps)
 SEGMENT_SIM_TIMEOUT = 60.0
 WALL_TIMEOUT = 600.0
+STEP_WALL_TIMEOUT = 30.0  # for one control period's /odom to arrive
+STARTUP_TIMEOUT = 120.0
 
 
 def _yaw(orientation) -> float:
@@ -51,24 +56,27 @@ def _yaw(orientation) -> float:
 class Recorder:
     """The robot's path from /odom and the lidar's hits from /scan, in the odom frame."""
 
-    def __init__(self):
-        self.lock = threading.Lock()
-        self.path, self.headings, self.scan_points = [], [], []
+    def __init__(self, sim: LockstepClient):
+        self.arrived = threading.Condition()
+        self.stamps, self.path, self.headings, self.scan_points = [], [], [], []
         self.scans = 0
-        self.odometry = None
         self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(120))
         self.tf_listener = tf2_ros.TransformListener(self.tf_buffer)
-        self.subscribers = [rospy.Subscriber("/odom", Odometry, self._on_odometry, queue_size=50),
-                            rospy.Subscriber("/scan", LaserScan, self._on_scan, queue_size=5)]
+        # Connected both ways before the first step, so no message of the tour is missed.
+        self.subscribers = [sim.subscriber("/odom", Odometry, self._on_odometry),
+                            sim.subscriber("/scan", LaserScan, self._on_scan)]
 
     def _on_odometry(self, message):
-        with self.lock:
-            self.odometry = message
+        with self.arrived:
             position = message.pose.pose.position
+            self.stamps.append(message.header.stamp.to_sec())
             self.path.append((position.x, position.y))
             self.headings.append(_yaw(message.pose.pose.orientation))
+            self.arrived.notify_all()
 
     def _on_scan(self, message):
+        # The transform at the scan's stamp may need odometry of the next control step: this waits (in sim time)
+        # for it on the subscriber's own thread while the tour goes on.
         try:
             transform = self.tf_buffer.lookup_transform("odom", message.header.frame_id, message.header.stamp,
                                                         rospy.Duration(1.0))
@@ -81,44 +89,63 @@ class Recorder:
         yaw = _yaw(q)
         x = ranges[hit] * numpy.cos(angles[hit] + yaw) + t.x
         y = ranges[hit] * numpy.sin(angles[hit] + yaw) + t.y
-        with self.lock:
+        with self.arrived:
             self.scans += 1
             self.scan_points.extend(zip(x.tolist(), y.tolist()))
 
-    def pose(self):
-        with self.lock:
-            if self.odometry is None:
-                return None
-            pose = self.odometry.pose.pose
-            return self.odometry.header.stamp.to_sec(), pose.position.x, pose.position.y, _yaw(pose.orientation)
+    def pose_at(self, sim_time: float, timeout: float):
+        """(stamp, x, y, yaw) of the last odometry stamped at or before ``sim_time``, once one stamped after it has
+        arrived: one connection delivers in order, so the answer does not depend on how fast messages travel."""
+        with self.arrived:
+            if not self.arrived.wait_for(lambda: self.stamps and self.stamps[-1] > sim_time, timeout):
+                raise RuntimeError(f"no /odom stamped after {sim_time:.3f} s arrived within {timeout:.0f} s")
+            index = bisect.bisect_right(self.stamps, sim_time) - 1
+            return None if index < 0 else (self.stamps[index], *self.path[index], self.headings[index])
 
-    def distance(self) -> float:
-        with self.lock:
-            return sum(math.dist(a, b) for a, b in zip(self.path, self.path[1:]))
+    def until(self, sim_time: float):
+        """The path, headings and scan points recorded up to ``sim_time``, and the number of scans."""
+        with self.arrived:
+            end = bisect.bisect_right(self.stamps, sim_time)
+            return self.path[:end], self.headings[:end], list(self.scan_points), self.scans
+
+    def distance(self, sim_time: float = math.inf) -> float:
+        path = numpy.asarray(self.until(sim_time)[0]).reshape(-1, 2)
+        return float(numpy.hypot(*numpy.diff(path, axis=0).T).sum())
 
 
 class Tour:
-    """Drives the tour closed-loop on odometry and shows progress."""
+    """Drives the tour closed-loop on odometry, stepping the simulation between commands, and shows progress.
 
-    def __init__(self, recorder, on_terminal):
+    Each command comes from the last odometry stamped at least half a control period before the time the
+    simulation stopped at, so every run reads the same odometry and sends the same commands, however fast the
+    machine and its messages are."""
+
+    def __init__(self, sim: LockstepClient, recorder: Recorder, step_size: float, on_terminal: bool):
+        self.sim = sim
         self.recorder = recorder
+        self.control_steps = max(1, round(CONTROL_PERIOD / step_size))
+        self.control_period = self.control_steps * step_size
         self.on_terminal = on_terminal
-        self.publisher = rospy.Publisher("/cmd_vel", Twist, queue_size=1, latch=True)
+        self.publisher = sim.publisher("/cmd_vel", Twist)
+        self.pose = None
         self.last_progress = 0.0
 
     def command(self, linear, angular):
         twist = Twist()
         twist.linear.x, twist.angular.z = linear, angular
-        self.publisher.publish(twist)
+        self.publisher.publish(twist)  # synchronous: the bridge applies it before the next step
+
+    def advance(self):
+        sim_time = self.sim.step(self.control_steps)
+        self.pose = self.recorder.pose_at(sim_time - self.control_period / 2, timeout=STEP_WALL_TIMEOUT) or self.pose
 
     def progress(self, final=False):
         now = time.monotonic()
         if not final and now - self.last_progress < (PROGRESS_PERIOD if self.on_terminal else 4 * PROGRESS_PERIOD):
             return
         self.last_progress = now
-        pose = self.recorder.pose()
-        sim_time = pose[0] if pose else 0.0
-        line = f"  sim {sim_time:6.1f} s | {self.recorder.distance():5.2f} m driven | {self.recorder.scans:4d} scans"
+        line = (f"  sim {self.pose[0]:6.1f} s | {self.recorder.distance():5.2f} m driven | "
+                f"{self.recorder.scans:4d} scans")
         # On a terminal one line updates in place; in a log, a line every few seconds.
         if self.on_terminal:
             print("\r" + line, end="\n" if final else "", file=sys.stderr, flush=True)
@@ -126,21 +153,21 @@ class Tour:
             print(line, file=sys.stderr, flush=True)
 
     def wait(self, done, what):
-        start = self.recorder.pose()[0]
+        start = self.pose[0]
         wall_deadline = time.monotonic() + WALL_TIMEOUT
-        while True:
-            pose = self.recorder.pose()
-            if done(pose):
-                return
-            if pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
-                raise RuntimeError(f"the robot did not finish '{what}' (stuck at x {pose[1]:.2f}, y {pose[2]:.2f})")
+        while not done(self.pose):
+            if self.pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
+                raise RuntimeError(f"the robot did not finish '{what}' (stuck at x {self.pose[1]:.2f}, "
+                                   f"y {self.pose[2]:.2f})")
             self.progress()
-            time.sleep(0.005)
+            self.advance()
 
     def run(self):
-        _, _, _, heading = self.recorder.pose()
+        while self.pose is None:
+            self.advance()
+        heading = self.pose[3]
         for kind, amount in TOUR:
-            _, x0, y0, _ = self.recorder.pose()
+            _, x0, y0, _ = self.pose
             if kind == "forward":
                 def forward(pose):
                     # Hold the heading the last turn ended on, so the legs come out straight.
@@ -185,12 +212,15 @@ def main(argv=None):
         with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
             simulation = subprocess.Popen(
                 ["roslaunch", "mbot_gazebo", "mbot_world.launch", "world_name:=" + world_path,
-                 "model:=" + model, f"gui:={str(args.gui).lower()}", "real_time_factor:=0"],
+                 "model:=" + model, f"gui:={str(args.gui).lower()}", "lockstep:=true"],
                 env=os.environ, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            print(f"mbot demo: {args.world} world, lidar mbot, as fast as the machine goes (log: "
-                  f"{os.path.relpath(log_dir)})", file=sys.stderr, flush=True)
+            print(f"mbot demo: {args.world} world, lidar mbot, stepped by the tour (log: {os.path.relpath(log_dir)})",
+                  file=sys.stderr, flush=True)
             return tour_and_draw(args, world_path, started, log_dir)
+        except KeyboardInterrupt:
+            print("\nmbot demo: interrupted", file=sys.stderr)
+            return 130
         finally:
             stop_process_group(simulation)
 
@@ -239,33 +269,31 @@ def camera_frame(world_path: str, x: float, y: float, yaw: float, log_path: str)
 
 def tour_and_draw(args, world_path, started, log_dir):
     rospy.init_node("mbot_demo", disable_signals=True)
-    recorder = Recorder()
-    deadline = time.monotonic() + 120
-    while recorder.pose() is None or recorder.scans == 0:
-        if time.monotonic() > deadline:
-            print("mbot demo: no /odom and /scan from the simulator within 120 s (see the log)", file=sys.stderr)
-            return 1
-        time.sleep(0.05)
-    tour = Tour(recorder, on_terminal=sys.stderr.isatty())
-    sim_start, wall_start = recorder.pose()[0], time.monotonic()
+    world = parse_world(world_path)
+    try:
+        sim = LockstepClient(timeout=STARTUP_TIMEOUT)
+        recorder = Recorder(sim)
+        tour = Tour(sim, recorder, world.physics.max_step_size, on_terminal=sys.stderr.isatty())
+    except (rospy.ROSException, RuntimeError) as error:
+        print(f"mbot demo: the simulator did not come up: {error} (see the log)", file=sys.stderr)
+        return 1
+    wall_start = time.monotonic()
     try:
         tour.run()
-    except RuntimeError as error:
+    except (RuntimeError, rospy.ServiceException) as error:
         print(f"\nmbot demo: {error}", file=sys.stderr)
         return 1
-    sim_seconds, wall_seconds = recorder.pose()[0] - sim_start, time.monotonic() - wall_start
-    with recorder.lock:
-        path, headings, points = list(recorder.path), list(recorder.headings), list(recorder.scan_points)
-        scans = recorder.scans
-    _, x, y, yaw = recorder.pose()
-    summary = [f"distance driven: {recorder.distance():.2f} m",
+    wall_seconds = time.monotonic() - wall_start
+    sim_seconds, x, y, yaw = tour.pose
+    path, headings, points, scans = recorder.until(sim_seconds)
+    summary = [f"distance driven: {recorder.distance(sim_seconds):.2f} m",
                f"tour: {sim_seconds:.1f} s of sim time in {wall_seconds:.1f} s of wall time (real-time factor "
                f"{sim_seconds / wall_seconds:.1f})",
                f"scans received: {scans} ({len(points)} points)",
                f"final odometry: x {x:.3f} m, y {y:.3f} m, yaw {math.degrees(yaw):.1f} deg"]
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     camera = camera_frame(world_path, x, y, yaw, os.path.join(log_dir, "kinect_frame.log"))
-    frame = draw_demo(parse_world(world_path), numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
+    frame = draw_demo(world, numpy.array(path), numpy.array(points).reshape(-1, 2), args.out,
                       title=f"mbot demo: {args.world}", summary_lines=summary, headings=numpy.array(headings),
                       camera_image=camera, camera_caption="the course's kinect at the end pose (640x480)")
     # Beside the picture: the recorded odometry and where the plot sits in the PNG, so the two can be compared.

@@ -4,6 +4,7 @@
     sim = LockstepClient()                              # waits for /gazebo/step_simulation
     cmd_vel = sim.publisher("/cmd_vel", Twist)          # synchronous; waits until the bridge subscribes
     odom = sim.recorder(["/odom"])                      # raw bytes per (topic, publisher), in arrival order
+    sim.subscriber("/scan", LaserScan, on_scan)         # or decoded messages to a callback
     cmd_vel.publish(Twist(linear=Vector3(x=0.2)))
     sim.step(500)                                       # the command is applied before the first step
     sim.settle()                                        # every message of those steps has been received
@@ -91,14 +92,16 @@ class LockstepClient:
         """Start recording ``topics``; returns once each has its number of ``publishers`` (default 1) connected."""
         recorder = Recorder(topics)
         for topic, subscriber in zip(topics, recorder.subscribers):
-            wanted = (publishers or {}).get(topic, 1)
-            self._wait(lambda: subscriber.subscriber.get_num_connections() >= wanted,
-                       f"{topic} to have {wanted} publishers")
-            # This side counts a connection as soon as it has one; a publisher counts it a little later, and the
-            # bridge skips publishing to nobody. Under load that gap swallowed a run's first messages.
-            self._wait(lambda: _publishers_sending(topic) >= wanted, f"{topic}'s publishers to count this node")
+            self._wait_connected(subscriber, topic, (publishers or {}).get(topic, 1))
         self._recorders.append(recorder)
         return recorder
+
+    def subscriber(self, topic: str, message_type, callback, publishers: int = 1) -> TrackedSubscriber:
+        """A subscriber whose ``callback`` gets every message from the next step on: returned once ``publishers``
+        nodes are connected to it and count this node."""
+        subscriber = TrackedSubscriber(topic, message_type, callback, queue_size=None)
+        self._wait_connected(subscriber, topic, publishers)
+        return subscriber
 
     def step(self, steps: int) -> float:
         """Advance exactly ``steps`` physics steps; returns the sim time after them."""
@@ -116,6 +119,13 @@ class LockstepClient:
         for recorder in self._recorders:
             recorder.close()
         self._step.close()
+
+    def _wait_connected(self, subscriber: TrackedSubscriber, topic: str, wanted: int):
+        self._wait(lambda: subscriber.subscriber.get_num_connections() >= wanted,
+                   f"{topic} to have {wanted} publishers")
+        # This side counts a connection as soon as it has one; a publisher counts it a little later, and the
+        # bridge skips publishing to nobody. Under load that gap swallowed a run's first messages.
+        self._wait(lambda: _publishers_sending(topic) >= wanted, f"{topic}'s publishers to count this node")
 
     def _wait(self, condition, what: str):
         deadline = time.monotonic() + self.timeout
