@@ -8,10 +8,8 @@ what to use instead. Options that have no meaning for the bridge warn once and a
 absence would make the run wrong (log playback, a fixed iteration count) are refused.
 """
 import argparse
-import cProfile
 import json
 import os
-import pdb
 import sys
 
 import rospkg
@@ -124,11 +122,14 @@ def gazebo():
 
 def debug():
     """The server under pdb (gazebo_ros runs gzserver under gdb)."""
+    import pdb  # here, not at the top: every launch imports this module, and pdb costs 15 ms of it
+
     _run("debug", pdb.Pdb().runcall)
 
 
 def perf():
     """The server under cProfile (gazebo_ros runs gzserver under valgrind's callgrind)."""
+    import cProfile
     path = os.path.join(rospkg.get_ros_home(), "gzserver.prof")
 
     def profile(main):
