@@ -17,13 +17,25 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
+def ignores_signal(pid: int, signum: int) -> bool:
+    """Whether process ``pid`` ignores ``signum`` (its SigIgn mask in /proc; False when it cannot be read)."""
+    try:
+        with open(f"/proc/{pid}/status") as status:
+            mask = next(int(line.split()[1], 16) for line in status if line.startswith("SigIgn:"))
+    except (OSError, StopIteration, ValueError, IndexError):
+        return False
+    return bool(mask >> (signum - 1) & 1)
+
+
 def stop_process_group(process: subprocess.Popen, timeout: float = 20.0) -> bool:
     """SIGINT the process's group (started with start_new_session=True), as Ctrl-C would; SIGKILL if it hangs.
 
-    False when it had to be killed (it ignored Ctrl-C for ``timeout`` seconds)."""
+    A process that ignores SIGINT gets SIGTERM instead: started from a script's background job (``cmd &``),
+    this process and every child it starts inherit an ignored SIGINT, and rosmaster would wait out the timeout.
+    False when it had to be killed (it ignored the signal for ``timeout`` seconds)."""
     if process.poll() is not None:
         return True
-    os.killpg(process.pid, signal.SIGINT)
+    os.killpg(process.pid, signal.SIGTERM if ignores_signal(process.pid, signal.SIGINT) else signal.SIGINT)
     try:
         process.wait(timeout=timeout)
         return True
