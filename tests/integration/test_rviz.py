@@ -33,6 +33,8 @@ MIN_SCAN_PIXELS = 100
 DRAW_TIMEOUT = 30.0
 # rviz must keep the scene up this long: a TF problem shows as the robot vanishing or as errors in its output.
 STEADY = 3.0
+# Each screenshot is an xwd, a PNG and its analysis: taken back to back they were a tenth of a test's CPU.
+SCREENSHOT_PERIOD = 0.5
 RVIZ_ATTEMPTS = 2
 # Config -> (launch file and args, the robot_description it draws, topics to wait for); others: the play ground.
 SCENES = {"multi_mbot.rviz": (("multi_mbot.launch", "count:=2"), "/mbot_1/robot_description",
@@ -146,19 +148,22 @@ def node_registered(master, name):
     return True
 
 
-def watch(server, path, condition, timeout, steady):
-    """Screenshots until ``condition(image)`` has held for ``steady`` seconds or ``timeout`` has passed.
+def watch(server, path, condition, timeout, steady, period=SCREENSHOT_PERIOD):
+    """Screenshots, one every ``period`` seconds, until ``condition(image)`` has held for ``steady`` seconds or
+    ``timeout`` has passed.
 
     Returns the last screenshot either way, for the assertions to explain what is missing.
     """
     deadline = time.monotonic() + timeout
     held_since = None
     while True:
+        taken = time.monotonic()
         image = server.screenshot(path)
         now = time.monotonic()
         held_since = (held_since or now) if condition(image) else None
         if (held_since is not None and now - held_since >= steady) or now > deadline:
             return image
+        time.sleep(max(0.0, taken + period - time.monotonic()))
 
 
 def view_3d(image, background):
