@@ -5,7 +5,10 @@ the bridge just before a step request (which arrives on another connection) may 
 half-way through its callback, when the request is served. ``drain`` waits until every tracked connection is
 idle: no unread bytes in the socket or in rospy's read buffer, no parse under way, and as many callbacks
 finished as messages parsed. rospy has no hook for this, so the connection's parser is wrapped to count what
-it parses (rospy 1.15's TCPROS transport: ``protocol.read_messages`` into an empty queue, then callbacks).
+it parses (rospy 1.15's TCPROS transport: ``protocol.read_messages`` into an empty queue, then callbacks),
+and rospy's ``recv_buff`` is wrapped so that a tracked connection's reader waits for bytes without taking
+them and counts as parsing before it takes them: a reader that had taken bytes and then waited for the GIL
+(milliseconds under load) looked idle, and a command published before a step request was applied after it.
 On one host a publisher's synchronous ``publish`` on a TCP_NODELAY connection (which these subscribers ask
 for) has put its bytes in the bridge's socket before it returns, so a node that publishes synchronously
 (``queue_size=None``) and then calls the step service sees its message applied before the first step.
@@ -13,11 +16,12 @@ for) has put its bytes in the bridge's socket before it returns, so a node that 
 import select
 import threading
 import time
-from typing import Callable, Iterable, List
+from typing import Callable, Iterable, List, Tuple
 
 import rospy
+import rospy.impl.tcpros_base as tcpros_base
 
-# Idle is checked twice this far apart, for bytes between the socket and rospy's buffer at the first look.
+# Idle is checked twice this far apart, for bytes on their way into the socket at the first look.
 _SETTLE_SECONDS = 0.002
 
 
@@ -43,6 +47,14 @@ class TrackedSubscriber:
         finally:
             with self._lock:
                 self._pending.discard(id(message))
+
+    def _mark_parsing(self, key) -> None:
+        with self._lock:
+            self._parsing.add(key)
+
+    def _unmark_parsing(self, key) -> None:
+        with self._lock:
+            self._parsing.discard(key)
 
     def _watch(self, connection):
         """Note what this connection's parser turns into messages (wrapped once per subscriber)."""
@@ -92,6 +104,43 @@ class TrackedSubscriber:
 
 
 _TRACKED: List[TrackedSubscriber] = []
+_ROSPY_RECV_BUFF = tcpros_base.recv_buff
+
+
+def _trackers_of(sock) -> List[Tuple[TrackedSubscriber, int]]:
+    """The tracked subscribers reading from ``sock``, each with its key for the connection."""
+    found = []
+    for subscriber in list(_TRACKED):
+        impl = subscriber.subscriber.impl
+        for connection in list(impl.connections if impl else ()):
+            if connection.socket is sock and connection.header is not None:
+                subscriber._watch(connection)
+                found.append((subscriber, id(connection.header)))
+    return found
+
+
+def _recv_buff(sock, buffer, size):
+    """rospy's recv_buff; on a tracked connection it first waits until bytes are there, without taking them
+    (the GIL is free meanwhile), then marks the connection as parsing, then takes them. The read_messages
+    wrapper of ``_watch`` clears the mark once they are parsed."""
+    trackers = _trackers_of(sock)
+    if trackers:
+        try:
+            select.select([sock], [], [])
+        except (ValueError, OSError):
+            pass  # closed meanwhile: rospy's own read reports it
+        for subscriber, key in trackers:
+            subscriber._mark_parsing(key)
+    try:
+        return _ROSPY_RECV_BUFF(sock, buffer, size)
+    except BaseException:
+        for subscriber, key in trackers:
+            subscriber._unmark_parsing(key)
+        raise
+
+
+# rospy's TCPROS transport calls the module's recv_buff by name for every read of a subscribed connection.
+tcpros_base.recv_buff = _recv_buff
 
 
 def drain(subscribers: Iterable[TrackedSubscriber] = None, timeout: float = 5.0) -> bool:
