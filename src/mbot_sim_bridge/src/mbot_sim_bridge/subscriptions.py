@@ -126,7 +126,9 @@ def _recv_buff(sock, buffer, size):
     trackers = _trackers_of(sock)
     if trackers:
         try:
-            select.select([sock], [], [])
+            waiting = select.poll()  # poll, not select: a process with many connections has descriptors past 1024
+            waiting.register(sock, select.POLLIN | select.POLLPRI)
+            waiting.poll()
         except (ValueError, OSError):
             pass  # closed meanwhile: rospy's own read reports it
         for subscriber, key in trackers:
