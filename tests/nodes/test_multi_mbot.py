@@ -50,7 +50,17 @@ class MultiMbot(unittest.TestCase):
             self.assertEqual((odom.header.frame_id, odom.child_frame_id), (robot + "/odom", robot + "/base_footprint"))
             self.assertEqual(scan.header.frame_id, robot + "/laser_link")
 
+    def at_rest(self, robot):
+        twist = self.odom[robot].twist.twist
+        return abs(twist.linear.x) < 1e-3 and abs(twist.angular.z) < 1e-3
+
     def test_each_scan_sees_its_nearest_neighbour(self):
+        # The drive test leaves the robots turning down to rest: a scan taken while a robot still turned would not
+        # match a pose read later. So compare poses with scans taken after every robot stands still.
+        wait_for(lambda: all(self.at_rest(robot) for robot in ROBOTS), what="every robot at rest")
+        settled = rospy.Time.now()
+        wait_for(lambda: all(self.scans[robot].header.stamp > settled for robot in ROBOTS),
+                 what="a scan of every robot taken at rest")
         poses = {robot: self.state(robot, "world").pose for robot in ROBOTS}
         lasers = {robot: (pose.position.x + LASER_X * math.cos(yaw_of(pose.orientation)),
                           pose.position.y + LASER_X * math.sin(yaw_of(pose.orientation)), yaw_of(pose.orientation))
