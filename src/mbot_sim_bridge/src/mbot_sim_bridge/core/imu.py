@@ -38,8 +38,7 @@ import numpy as np
 from . import names
 from .clock import EveryStopTimer, UpdateTimer
 from .errors import ConfigError
-from .geometry import (IDENTITY, Pose, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrices,
-                       rotation_matrix)
+from .geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrix
 from .log import get_logger, warn_once
 from .params import ERROR_MODEL_LIMIT, Param, PluginParams, non_negative
 from .plugin import Plugin
@@ -146,6 +145,7 @@ class ImuModelPlugin(Plugin):
         read_vector_param(element, "xyzOffset", self.label, where)
         rpy = read_vector_param(element, "rpyOffset", self.label, where) or (0.0, 0.0, 0.0)
         self.offset = pose_from_xyz_rpy((0.0, 0.0, 0.0), rpy).orientation
+        self._offset_rotation = np.array(rotation_matrix(self.offset))
         self.noise = self.params["gaussianNoise"]
         self.rng = context.random_stream(element.get("name") or "imu")
         simulation = context.simulation
@@ -201,20 +201,22 @@ class ImuModelPlugin(Plugin):
         simulation = self.context.simulation
         count, step, last_step = len(self._rows), simulation.step_size, simulation.engine.steps
         stamps = np.arange(last_step - count + 1, last_step + 1) * step
-        _, orientations, velocities, angular = self.context.robot.recorded_link_states(self.link, self._rows)
+        orientations, rotations, velocities, angular = self.context.robot.recorded_link_states(self.link, self._rows)
         if self.offset != IDENTITY.orientation:
             orientations = quaternion_products(self.offset, orientations)
+            rotations = self._offset_rotation @ rotations
         # Δv/Δt from each step's velocity and the one before (the last reading's for the first row).
-        accelerations = np.diff(velocities, axis=0, prepend=self._last_velocity[None])
+        accelerations = np.empty_like(velocities)
         first_interval = stamps[0] - self._last_time
-        accelerations[0] = accelerations[0] / first_interval if first_interval > 0 else 0.0
+        accelerations[0] = (velocities[0] - self._last_velocity) / first_interval if first_interval > 0 else 0.0
+        np.subtract(velocities[1:], velocities[:-1], out=accelerations[1:])
         accelerations[1:] /= step
         self._last_velocity, self._last_time = velocities[-1], stamps[-1]
         if self.noise > 0:
             noise = self.rng.normal(0.0, self.noise, (count, 6))
             angular, accelerations = angular + noise[:, :3], accelerations + noise[:, 3:]
-        rotated = rotation_matrices(orientations) @ np.stack((angular, accelerations), axis=-1)
-        return ImuReadings(stamps, orientations, rotated[..., 0], rotated[..., 1], self.noise ** 2)
+        return ImuReadings(stamps, orientations, (rotations @ angular[..., None])[..., 0],
+                           (rotations @ accelerations[..., None])[..., 0], self.noise ** 2)
 
 
 class AxisNoise(NamedTuple):

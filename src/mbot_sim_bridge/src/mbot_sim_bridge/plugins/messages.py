@@ -1,4 +1,5 @@
 """The ROS messages the plugins publish, filled from the core's values: one place for the field layouts."""
+import functools
 from typing import Sequence
 
 import numpy as np
@@ -44,28 +45,35 @@ def imu_message(reading: ImuReading, frame_id: str) -> Imu:
     return message
 
 
-def imu_records(readings: ImuReadings, frame_id: str) -> np.ndarray:
-    """sensor_msgs/Imu messages as they go on the wire, one numpy record per reading, each with its length
-    prefix; ``LoopPublisher.publish_records`` numbers them (``seq``). genpy would build and serialize a message
-    object per reading, which at 1000 readings a sim second costs more than the physics."""
+@functools.lru_cache(maxsize=64)
+def _imu_record_template(frame_id: str, covariance: float) -> np.ndarray:
+    """One sensor_msgs/Imu record with every field a topic's messages share filled in."""
     frame = frame_id.encode()
     layout = np.dtype([("length", "<u4"), ("seq", "<u4"), ("secs", "<u4"), ("nsecs", "<u4"),
                        ("frame_length", "<u4"), ("frame_id", np.uint8, (len(frame),)),
                        ("orientation", "<f8", (4,)), ("orientation_covariance", "<f8", (9,)),
                        ("angular_velocity", "<f8", (3,)), ("angular_velocity_covariance", "<f8", (9,)),
                        ("linear_acceleration", "<f8", (3,)), ("linear_acceleration_covariance", "<f8", (9,))])
-    records = np.zeros(len(readings.stamps), layout)
-    records["length"] = layout.itemsize - 4
+    record = np.zeros(1, layout)
+    record["length"] = layout.itemsize - 4
+    record["frame_length"] = len(frame)
+    record["frame_id"] = np.frombuffer(frame, np.uint8)
+    covariance_matrix = diagonal_covariance(covariance, 3)
+    for field in ("orientation_covariance", "angular_velocity_covariance", "linear_acceleration_covariance"):
+        record[field] = covariance_matrix
+    return record
+
+
+def imu_records(readings: ImuReadings, frame_id: str) -> np.ndarray:
+    """sensor_msgs/Imu messages as they go on the wire, one numpy record per reading, each with its length
+    prefix; ``LoopPublisher.publish_records`` numbers them (``seq``). genpy would build and serialize a message
+    object per reading, which at 1000 readings a sim second costs more than the physics."""
+    records = np.repeat(_imu_record_template(frame_id, readings.covariance), len(readings.stamps))
     # ros_time's rounding, for every stamp at once.
     records["secs"], records["nsecs"] = np.divmod(np.rint(readings.stamps * 1e9).astype(np.int64), 1000000000)
-    records["frame_length"] = len(frame)
-    records["frame_id"] = np.frombuffer(frame, np.uint8)
     records["orientation"] = readings.orientations
     records["angular_velocity"] = readings.angular_velocities
     records["linear_acceleration"] = readings.linear_accelerations
-    covariance = diagonal_covariance(readings.covariance, 3)
-    for field in ("orientation_covariance", "angular_velocity_covariance", "linear_acceleration_covariance"):
-        records[field] = covariance
     return records
 
 
