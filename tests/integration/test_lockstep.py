@@ -10,14 +10,17 @@ own ROS time allows, which depends on when /clock reaches it."""
 import os
 import pickle
 import struct
+import subprocess
 import threading
 import time
 
 import pytest
+import rosgraph
 from mbot_sim_bridge.processes import stop_process_group
 from ros_processes import TESTS, call_service, run, service_up, wait_until
 
 SCRIPT = os.path.join(TESTS, "nodes", "lockstep_script.py")
+LOG_STAMP = os.path.join(TESTS, "nodes", "log_stamp.py")
 LAUNCH = os.path.join(TESTS, "launch", "lockstep_mbot.launch")
 # Messages that start with a std_msgs/Header: rospy writes its per-publisher counter into header.seq.
 TOPICS_WITH_HEADER = ("/odom", "/scan", "/joint_states")
@@ -84,6 +87,20 @@ def test_step_simulation_answers_every_count(ros_env, launch):
         call_service(ros_env, STEP, f"{{steps: {2 ** 63}}}")
     response = call_service(ros_env, STEP, "{steps: 10}")
     assert response["success"] and response["sim_time"] == pytest.approx(0.01), response
+    # The simulator's own ROS time is sim time too (it sets rospy's time as it publishes /clock, rather than
+    # subscribing to its own /clock): what it logs now is stamped 0.01.
+    log_stamp = subprocess.Popen(["python3", LOG_STAMP, "no_such_model"], env=ros_env, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True)
+    try:
+        assert log_stamp.stdout.readline().strip() == "ready", log_stamp.stderr.read()
+        response = call_service(ros_env, "/gazebo/delete_model", "{model_name: no_such_model}")
+        assert not response["success"], response
+        assert log_stamp.stdout.readline().strip() == "0.010000000", log_stamp.stderr.read()
+    finally:
+        log_stamp.kill()
+        log_stamp.communicate()
+    subscribers = dict(rosgraph.Master("/test", master_uri=ros_env["ROS_MASTER_URI"]).getSystemState()[1])
+    assert "/gazebo" not in subscribers["/clock"], subscribers["/clock"]
     # The longest call allowed (an hour of sim time) still ends at Ctrl-C within a second or two.
     long_call = threading.Thread(target=call_ignoring_errors, args=(ros_env, STEP, "{steps: 3600000}"), daemon=True)
     long_call.start()
