@@ -6,12 +6,14 @@ import pytest
 WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 
 
-def expand_xacro(relative_path: str) -> str:
-    """Run the real xacro on a file of mbot_description, as robot_description would hold it."""
+def expand_xacro(relative_path: str, **arguments: str) -> str:
+    """Run the real xacro on a file of mbot_description, as robot_description would hold it; ``arguments`` are
+    its xacro:arg values (``name:=value`` on the command line)."""
     os.environ["ROS_PACKAGE_PATH"] = WORKSPACE_SRC + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
     import xacro_noetic as xacro
-    # mappings: the xacro:arg defaults apply (xacro's Python API needs the argument map, even empty).
-    return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path), mappings={}).toxml()
+    # mappings: the xacro:arg values not given keep their defaults (xacro's Python API needs the map, even empty).
+    return xacro.process_file(os.path.join(WORKSPACE_SRC, "mbot_description", relative_path),
+                              mappings=arguments).toxml()
 
 
 @pytest.fixture(scope="session")

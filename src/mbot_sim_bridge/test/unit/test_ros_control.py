@@ -74,6 +74,20 @@ def test_the_mbot_wheels_are_velocity_joints_without_limits(mbot):
     assert plugin.control_period == pytest.approx(0.001)
 
 
+def test_the_mbot_xacro_argument_control_period_sets_how_often_the_controllers_update():
+    urdf = expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro", control_period="0.01")
+    sim, _, plugin = simulate(urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+    try:
+        assert plugin.control_period == pytest.approx(0.01)
+        updates = []
+        update = plugin.manager.update
+        plugin.manager.update = lambda now, period, reset=False: (updates.append(period), update(now, period, reset))
+        sim.step(1000)
+        assert len(updates) == 100 and all(period == pytest.approx(0.01) for period in updates[1:])
+    finally:
+        sim.close()
+
+
 def test_joint_limit_parameters_override_the_urdf():
     limits = apply_limit_params(JointLimits(True, -1.0, 1.0, True, 2.0), {
         "has_velocity_limits": True, "max_velocity": 0.5, "has_effort_limits": True, "max_effort": 7}, "j")
