@@ -178,16 +178,14 @@ class SpawnedRobot:
 
     def link_state_recorder(self, link_name: str, rows: list) -> Callable[[], None]:
         """A call that appends the Bullet state of ``link_name``'s body link to ``rows``, for ``Engine.step`` to
-        make after every step (about 2.5 us); ``recorded_link_states`` turns the rows into world values."""
+        make after every step (about 3.5 us); ``recorded_link_states`` turns the rows into world values."""
         index = self.link_index[self.model.lumped_into[link_name][0]]
         body, append = self.body, rows.append
-        # pybullet's functions with the client id given positionally: BulletClient's partials add 1.6 us a step.
-        client = self.client._client
         if index == -1:
-            pose, velocity = pybullet.getBasePositionAndOrientation, pybullet.getBaseVelocity
-            return lambda: append(pose(body, client) + velocity(body, client))
-        state = pybullet.getLinkState
-        return lambda: append(state(body, index, 1, 1, client))
+            pose, velocity = self.client.getBasePositionAndOrientation, self.client.getBaseVelocity
+            return lambda: append(pose(body) + velocity(body))
+        state = self.client.getLinkState
+        return lambda: append(state(body, index, 1, 1))
 
     def recorded_link_states(self, link_name: str, rows: Sequence[tuple]) -> RecordedLinkStates:
         """From ``link_state_recorder``'s rows, the frame of ``link_name`` at each step, as ``link_world_pose``
