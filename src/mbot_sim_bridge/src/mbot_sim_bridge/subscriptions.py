@@ -67,8 +67,7 @@ class TrackedSubscriber:
         key, parse = id(connection.header), protocol.read_messages
 
         def read_messages(buffer, queue, sock):
-            with self._lock:
-                self._parsing.add(key)
+            self._mark_parsing(key)
             try:
                 parse(buffer, queue, sock)
             finally:
@@ -84,7 +83,7 @@ class TrackedSubscriber:
                 continue
             self._watch(connection)
             try:
-                readable, _, _ = select.select([sock], [], [], 0.0)
+                readable = readable_within(sock, 0)
             except (ValueError, OSError):  # closed under us: nothing more will come from it
                 continue
             with self._lock:
@@ -101,6 +100,14 @@ class TrackedSubscriber:
         self.subscriber.unregister()
         if self in _TRACKED:
             _TRACKED.remove(self)
+
+
+def readable_within(sock, timeout_ms) -> bool:
+    """Whether ``sock`` has bytes to read (or has been closed) within ``timeout_ms`` (None: wait for it). poll,
+    not select: select refuses descriptors past 1024, which a process with many connections has."""
+    waiting = select.poll()
+    waiting.register(sock, select.POLLIN | select.POLLPRI)
+    return bool(waiting.poll(timeout_ms))
 
 
 _TRACKED: List[TrackedSubscriber] = []
@@ -126,9 +133,7 @@ def _recv_buff(sock, buffer, size):
     trackers = _trackers_of(sock)
     if trackers:
         try:
-            waiting = select.poll()  # poll, not select: a process with many connections has descriptors past 1024
-            waiting.register(sock, select.POLLIN | select.POLLPRI)
-            waiting.poll()
+            readable_within(sock, None)
         except (ValueError, OSError):
             pass  # closed meanwhile: rospy's own read reports it
         for subscriber, key in trackers:
