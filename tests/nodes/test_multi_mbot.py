@@ -51,7 +51,8 @@ class MultiMbot(unittest.TestCase):
             self.assertEqual(scan.header.frame_id, robot + "/laser_link")
 
     def at_rest(self, robot):
-        twist = self.odom[robot].twist.twist
+        with self.lock:
+            twist = self.odom[robot].twist.twist
         return abs(twist.linear.x) < 1e-3 and abs(twist.angular.z) < 1e-3
 
     def test_each_scan_sees_its_nearest_neighbour(self):

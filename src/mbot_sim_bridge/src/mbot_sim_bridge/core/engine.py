@@ -200,7 +200,7 @@ class SpawnedRobot:
         if on_base:
             # The base's rows: its centre of mass's position, orientation, linear and angular velocity.
             reference_orientations, com_linear, angular = state[:, 3:7], state[:, 7:10], state[:, 10:13]
-            com_to_reference = 0.0
+            com_to_reference = None  # the reference is the centre of mass
             if link_name not in self._frames_from_com:
                 self._frames_from_com[link_name] = compose(self.root_from_com, offset)
             offset = self._frames_from_com[link_name]
@@ -209,7 +209,9 @@ class SpawnedRobot:
             reference_orientations, com_linear, angular = state[:, 17:21], state[:, 21:24], state[:, 24:27]
             com_to_reference = state[:, 14:17] - state[:, :3]
         reference_rotations = rotation_matrices(reference_orientations)
-        com_to_frame = com_to_reference + reference_rotations @ offset.position
+        com_to_frame = reference_rotations @ offset.position
+        if com_to_reference is not None:
+            com_to_frame += com_to_reference
         linear = com_linear + cross_products(angular, com_to_frame)
         if offset.orientation == IDENTITY.orientation:
             return RecordedLinkStates(reference_orientations, reference_rotations, linear, angular)
