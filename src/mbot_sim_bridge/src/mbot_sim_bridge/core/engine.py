@@ -167,6 +167,11 @@ class SpawnedRobot:
         states = self.client.getJointStates(self.body, [self.joint_index[name] for name in joint_names])
         return [(state[0], state[1], state[3]) for state in states]
 
+    def joint_rows(self, indices: Sequence[int]):
+        """PyBullet's getJointStates rows (position, velocity, reaction wrench, applied effort) of joints by
+        ``joint_index``: joint_state without its name lookups and copies, for readers after every step."""
+        return self.client.getJointStates(self.body, indices)
+
     def link_world_velocity(self, link_name: str):
         """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
         index = self.link_index[self.model.lumped_into[link_name][0]]

@@ -367,24 +367,32 @@ class Simulation:
 
         def on_step():
             if plugin in model.plugins:  # a failed plugin is removed from its model's few
-                self._guarded(plugin, plugin.on_step, step_size)
+                # _guarded inlined: this runs after every physics step, where each call frame shows
+                try:
+                    plugin.on_step(step_size)
+                except Exception as error:  # the plugin boundary, as in _guarded
+                    self._disable(plugin, error)
         return on_step
 
     def _guarded(self, plugin: Plugin, method, argument):
-        """``method(argument)``; a plugin that raises is logged once, closed and dropped (None is returned), and
-        the simulation and other models go on."""
+        """``method(argument)``; a plugin that raises is disabled (None is returned), and the simulation and
+        other models go on."""
         try:
             return method(argument)
         except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
-            _logger.error(f"model '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
-                          f"{type(error).__name__}: {error}")
-            _logger.debug(f"the failure of {plugin.label}", exc_info=True)
-            plugin.context.model.plugins.remove(plugin)
-            try:
-                plugin.close()
-            except Exception:  # closing a broken plugin may fail too; it is gone either way
-                _logger.debug(f"closing {plugin.label} failed", exc_info=True)
-            self._schedule()
+            self._disable(plugin, error)
+
+    def _disable(self, plugin: Plugin, error: Exception):
+        """A plugin that raised: logged once, closed and dropped."""
+        _logger.error(f"model '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
+                      f"{type(error).__name__}: {error}")
+        _logger.debug(f"the failure of {plugin.label}", exc_info=error)
+        plugin.context.model.plugins.remove(plugin)
+        try:
+            plugin.close()
+        except Exception:  # closing a broken plugin may fail too; it is gone either way
+            _logger.debug(f"closing {plugin.label} failed", exc_info=True)
+        self._schedule()
 
     # -- reset ---------------------------------------------------------------------------------------------------
     def reset(self, simulation: bool):

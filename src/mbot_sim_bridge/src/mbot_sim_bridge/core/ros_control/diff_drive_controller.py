@@ -3,12 +3,10 @@ URDF, multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated f
 Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``."""
 import collections
 import math
-import threading
-from typing import List, Optional
+from typing import List, Optional, Tuple
 
 from ..log import get_logger, warn_once
 from ..robot_model import RobotModel
-from .control_toolbox import clamp
 from .controller_manager import ControllerInitError
 from .hardware_interface import VELOCITY
 from ..clock import steps_until_past
@@ -43,14 +41,15 @@ class SpeedLimiter:
         return limiter
 
     def limit(self, v: float, v0: float, v1: float, dt: float) -> float:
-        """The limited command, given the last two commands v0 (previous) and v1 (before that)."""
+        """The limited command, given the last two commands v0 (previous) and v1 (before that); clamps written
+        out (min of max), as this runs twice on every control cycle."""
         if self.has_jerk_limits:
             dv, dv0, dt2 = v - v0, v0 - v1, 2.0 * dt * dt
-            v = v0 + dv0 + clamp(dv - dv0, self.min_jerk * dt2, self.max_jerk * dt2)
+            v = v0 + dv0 + min(max(dv - dv0, self.min_jerk * dt2), self.max_jerk * dt2)
         if self.has_acceleration_limits:
-            v = v0 + clamp(v - v0, self.min_acceleration * dt, self.max_acceleration * dt)
+            v = v0 + min(max(v - v0, self.min_acceleration * dt), self.max_acceleration * dt)
         if self.has_velocity_limits:
-            v = clamp(v, self.min_velocity, self.max_velocity)
+            v = min(max(v, self.min_velocity), self.max_velocity)
         return v
 
 
@@ -67,9 +66,8 @@ class DiffDriveOdometry:
         self.reset_accumulators()
 
     def reset_accumulators(self):
-        self._linear = collections.deque()
-        self._angular = collections.deque()
-        self._sums = [0.0, 0.0]
+        self._speeds = collections.deque()  # (linear, angular) of the last ``window`` updates
+        self._linear_sum = self._angular_sum = 0.0
 
     def init(self, now: float):
         self.reset_accumulators()
@@ -89,17 +87,21 @@ class DiffDriveOdometry:
         if dt < 0.0001:
             return False  # too short an interval to estimate speeds
         self.timestamp = now
-        self.linear = self._rolling_mean(self._linear, 0, linear / dt)
-        self.angular = self._rolling_mean(self._angular, 1, angular / dt)
+        self.linear, self.angular = self._rolling_means(linear / dt, angular / dt)
         return True
 
-    def _rolling_mean(self, window: collections.deque, index: int, value: float) -> float:
-        """boost's rolling_mean over the last ``window`` values, kept as a running sum."""
-        window.append(value)
-        self._sums[index] += value
-        if len(window) > self.window:
-            self._sums[index] -= window.popleft()
-        return self._sums[index] / len(window)
+    def _rolling_means(self, linear: float, angular: float) -> Tuple[float, float]:
+        """boost's rolling_mean of each speed over the last ``window`` updates, kept as running sums."""
+        speeds = self._speeds
+        speeds.append((linear, angular))
+        self._linear_sum += linear
+        self._angular_sum += angular
+        if len(speeds) > self.window:
+            old_linear, old_angular = speeds.popleft()
+            self._linear_sum -= old_linear
+            self._angular_sum -= old_angular
+        count = len(speeds)
+        return self._linear_sum / count, self._angular_sum / count
 
     def update_open_loop(self, linear: float, angular: float, now: float):
         self.linear, self.angular = linear, angular
@@ -194,8 +196,8 @@ class DiffDriveController(Controller):
                      f"right wheel radius {right_radius}")
         self.left = [self.handle(joint) for joint in left]
         self.right = [self.handle(joint) for joint in right]
-        self._lock = threading.Lock()
-        self._command = (0.0, 0.0, -math.inf)  # linear, angular, stamp (sim s)
+        # linear, angular, stamp (sim s): one tuple, replaced whole by the ROS thread, read whole by the loop
+        self._command = (0.0, 0.0, -math.inf)
         self.last0 = self.last1 = (0.0, 0.0)
         self.last_publish = 0.0
         self.limited = (0.0, 0.0)
@@ -238,8 +240,7 @@ class DiffDriveController(Controller):
             return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
         if not (math.isfinite(linear) and math.isfinite(angular)):
             return "Received NaN in velocity command. Ignoring."
-        with self._lock:
-            self._command = (linear, angular, stamp)
+        self._command = (linear, angular, stamp)
         return None
 
     def brake(self):
@@ -257,8 +258,7 @@ class DiffDriveController(Controller):
     def restart_clock(self, now):
         self.last_publish = now
         self.odometry.timestamp = now
-        with self._lock:
-            self._command = (0.0, 0.0, -math.inf)
+        self._command = (0.0, 0.0, -math.inf)
 
     def update(self, now, period):
         # Upstream re-applies the multipliers every cycle for dynamic_reconfigure, which is not served here:
@@ -267,13 +267,12 @@ class DiffDriveController(Controller):
             self.odometry.update_open_loop(self.last0[0], self.last0[1], now)
         else:
             count = len(self.left)
-            left = sum(joint.position for joint in self.left) / count
-            right = sum(joint.position for joint in self.right) / count
+            left = sum([joint.position for joint in self.left]) / count
+            right = sum([joint.position for joint in self.right]) / count
             if math.isnan(left) or math.isnan(right):
                 return
             self.odometry.update(left, right, now)
-        with self._lock:
-            linear, angular, stamp = self._command
+        linear, angular, stamp = self._command
         if now - stamp > self.cmd_vel_timeout:
             linear = angular = 0.0
         linear = self.limiter_linear.limit(linear, self.last0[0], self.last1[0], period)

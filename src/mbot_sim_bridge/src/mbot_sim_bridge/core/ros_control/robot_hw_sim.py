@@ -13,7 +13,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 from ..errors import ConfigError
 from ..log import get_logger, info_once, warn_once
 from ..robot_model import RobotModel
-from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
+from .angles import normalize_angle, shortest_angular_distance, shortest_angular_distance_with_limits
 from .control_toolbox import Pid, clamp
 from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,
                                  UNBOUNDED_EFFORT, VELOCITY, HardwareInterfaceError)
@@ -24,6 +24,8 @@ from .transmissions import Transmission
 _logger = get_logger(__name__)
 
 _COMMAND_KIND = {EFFORT: "effort", POSITION: "position", VELOCITY: "velocity"}
+# What the engine can carry out, by motor mode (a joint's own limits apply before).
+_ENGINE_BOUND = {"velocity": MAX_JOINT_SPEED, "effort": UNBOUNDED_EFFORT, "position": math.inf}
 
 
 @dataclass
@@ -127,6 +129,7 @@ class DefaultRobotHWSim:
                     info_once(_logger, f"{label}: {why}: joint '{joint_name}' is driven directly ({drive})")
             self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid, soft_limits)
         self.names = list(self.joints)
+        self._indices = [robot.joint_index[name] for name in self.names]
 
     def _check_limits(self, joint: str, interface: str, limits: Optional[JointLimits],
                       soft_limits: Optional[SoftJointLimits]):
@@ -158,18 +161,19 @@ class DefaultRobotHWSim:
         once the batch of steps ends, and the controllers must not carry the NaN past a reset."""
         if not self.names:
             return True
-        states = self.robot.joint_state(self.names)
-        # One sum in C instead of a test per value: finite states cannot overflow it (efforts and speeds are
+        rows = self.robot.joint_rows(self._indices)
+        # One sum instead of a test per value: finite states cannot overflow it (efforts and speeds are
         # bounded far below the float range), so a non-finite sum means a NaN or inf in the state.
-        if not math.isfinite(sum(map(sum, states))):
+        if not math.isfinite(sum([row[0] + row[1] + row[3] for row in rows])):
             return False
-        for joint, (position, velocity, effort) in zip(self.joints.values(), states):
+        for joint, row in zip(self.joints.values(), rows):
             if joint.joint_type == "prismatic":
-                joint.position = position
+                joint.position = row[0]
             else:
-                joint.position += shortest_angular_distance(joint.position, position)
-            joint.velocity = velocity
-            joint.effort = effort
+                # shortest_angular_distance(joint.position, row[0]) without its extra call (every step)
+                joint.position += normalize_angle(row[0] - joint.position)
+            joint.velocity = row[1]
+            joint.effort = row[3]
         return True
 
     def write_sim(self, period: float):
@@ -183,7 +187,8 @@ class DefaultRobotHWSim:
         for joint in self.joints.values():
             if joint.interface == POSITION and self.e_stop_active:
                 joint.command = self._held_positions.get(joint.name, joint.position)
-            joint.command = self._finite(joint, _COMMAND_KIND[joint.interface], joint.command)
+            if not math.isfinite(joint.command):
+                joint.command = self._finite(joint, _COMMAND_KIND[joint.interface], joint.command)
             if joint.limits is not None:
                 self._saturate(joint, period)
             self._drive(joint, period)
@@ -289,18 +294,17 @@ class DefaultRobotHWSim:
                            f"the joint is held ({hold:g}) until a finite command arrives")
         return hold
 
-    def _within_engine(self, joint: SimJoint, mode: str, value: float) -> float:
-        """``value`` clamped to what the engine can carry out: joint speeds to its MAX_JOINT_SPEED, efforts to
-        UNBOUNDED_EFFORT (a joint's own limits have been applied before); said once per joint."""
-        bound = MAX_JOINT_SPEED if mode == "velocity" else UNBOUNDED_EFFORT if mode == "effort" else math.inf
-        if abs(value) <= bound:
-            return value
+    def _clamped_to_engine(self, joint: SimJoint, mode: str, value: float) -> float:
+        """A ``value`` beyond ``_ENGINE_BOUND`` at its bound (joint speeds at MAX_JOINT_SPEED, efforts at
+        UNBOUNDED_EFFORT); said once per joint."""
+        bound = _ENGINE_BOUND[mode]
         warn_once(_logger, f"{self.label}: joint '{joint.name}': {mode} command {value:g} is beyond the engine's "
                            f"{bound:g}; clamped")
         return math.copysign(bound, value)
 
     def _send(self, joint: SimJoint, mode: str, value: float):
-        value = self._within_engine(joint, mode, value)  # finite: write_sim and _drive have seen to that
+        if abs(value) > _ENGINE_BOUND[mode]:  # value is finite: write_sim and _drive have seen to that
+            value = self._clamped_to_engine(joint, mode, value)
         # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is not
         # sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's SetForce).
         setting = (self.robot.loads, mode, value)
