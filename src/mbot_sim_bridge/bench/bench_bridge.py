@@ -57,15 +57,20 @@ def raw_pybullet_rtf(sim_seconds: float) -> float:
     return sim_seconds / elapsed
 
 
-def _launch():
-    return subprocess.Popen(["roslaunch", "mbot_gazebo", "mbot_world.launch", "gui:=false", "real_time_factor:=0"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+MBOT_WORLD = ("mbot_gazebo", "mbot_world.launch", "gui:=false", "real_time_factor:=0")
+# The same roslaunch with a bare rospy node publishing /odom in the simulator's place.
+LAUNCH_FLOOR = (os.path.join(HERE, "launch_floor.launch"),)
 
 
-def first_odom_seconds() -> float:
+def _launch(arguments=MBOT_WORLD):
+    return subprocess.Popen(["roslaunch", *arguments], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+
+
+def first_odom_seconds(arguments=MBOT_WORLD) -> float:
     """Wall time from roslaunch to the first /odom: one launch, stopped again."""
     started = time.monotonic()
-    launch = _launch()
+    launch = _launch(arguments)
     try:
         rospy.wait_for_message("/odom", Odometry, timeout=120)
         return time.monotonic() - started
@@ -141,10 +146,16 @@ def main():
         beside = sum(seconds for kind, seconds in cpu.items() if kind != "bridge")
         print(f"bridge / raw at most, with the processes beside the bridge as measured and a bridge costing what "
               f"raw PyBullet does: {os.cpu_count() / (1 / raw + beside) / raw:.2f}", flush=True)
-        # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several.
-        launches = sorted(first_odom_seconds() for _ in range(args.launches))
+        # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several,
+        # each beside a launch of the floor, in turn.
+        pairs = [(first_odom_seconds(), first_odom_seconds(LAUNCH_FLOOR)) for _ in range(args.launches)]
+        launches, floors = sorted(launch for launch, _ in pairs), sorted(floor for _, floor in pairs)
         print(f"roslaunch to first /odom: median {statistics.median(launches):.2f} s ({len(launches)} launches, "
-              f"{launches[0]:.2f} to {launches[-1]:.2f} s)", flush=True)
+              f"{launches[0]:.2f} to {launches[-1]:.2f} s)")
+        print(f"the same roslaunch with a bare rospy node publishing /odom instead of the simulator and spawn_model "
+              f"(launch_floor.launch): median {statistics.median(floors):.2f} s ({floors[0]:.2f} to "
+              f"{floors[-1]:.2f} s); the simulator's part: median "
+              f"{statistics.median(launch - floor for launch, floor in pairs):.2f} s", flush=True)
     # The others, each in a process of its own (each starts its own master and rospy node).
     for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_lidar3d.py", "bench_stereo.py",
                    "bench_cameras.py"):
