@@ -7,7 +7,7 @@ import textwrap
 import pytest
 from mbot_sim_bridge.core.model_path import find_model_directory, find_world_file
 from mbot_sim_bridge.gazebo_paths import model_path as default_model_path
-from mbot_sim_bridge.gazebo_paths import package_exports
+from mbot_sim_bridge.gazebo_paths import package_exports, prefetch_package_exports
 from mbot_sim_bridge.gazebo_paths import resource_path as default_resource_path
 from mbot_sim_bridge.gzserver import CommandLineError, bridge_arguments
 
@@ -63,6 +63,16 @@ def test_exports_of_packages_depending_on_gazebo_ros_with_prefix_replaced(packag
     assert package_exports("gazebo_model_path") == [worlds + "/models", worlds + "/more_models"]
     assert package_exports("gazebo_media_path") == [worlds]
     assert package_exports("plugin_path") == []
+
+
+def test_a_prefetched_rospack_run_gives_the_same_exports_and_is_used_once(packages, monkeypatch):
+    root, _ = packages
+    worlds = str(root / "my_worlds")
+    prefetch_package_exports("gazebo_model_path")
+    # The run started above is the one collected: with rospack gone from PATH now, only it can answer.
+    monkeypatch.setenv("PATH", "/nonexistent")
+    assert package_exports("gazebo_model_path") == [worlds + "/models", worlds + "/more_models"]
+    assert package_exports("gazebo_model_path") == []  # the next call runs rospack again, and it is missing
 
 
 def test_gazebo_model_path_comes_first_then_the_exports(packages, monkeypatch):

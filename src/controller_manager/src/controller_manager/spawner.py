@@ -20,7 +20,7 @@ import yaml
 from controller_manager_msgs.srv import LoadController, SwitchController, SwitchControllerRequest, UnloadController
 from std_msgs.msg import Bool
 
-from mbot_sim_bridge.processes import stop_on_signals
+from mbot_sim_bridge.processes import init_node, stop_on_signals
 
 _POLL_SECONDS = 0.5
 
@@ -146,7 +146,7 @@ class Spawner:
 def main():
     args = parse_args(rospy.myargv()[1:])
     stop = stop_on_signals()
-    rospy.init_node("spawner", anonymous=True, disable_signals=True)
+    init_node("spawner", anonymous=True, disable_signals=True)
     if args.shutdown_timeout is not None:
         rospy.logwarn("DEPRECATION warning: --shutdown-timeout has no effect.")
     spawner = Spawner(args, stop)

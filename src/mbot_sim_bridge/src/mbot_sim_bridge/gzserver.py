@@ -16,7 +16,7 @@ import rospkg
 import rospy
 
 from .core.model_path import find_world_file
-from .gazebo_paths import resource_path
+from .gazebo_paths import prefetch_package_exports, resource_path
 
 # gazebo_ros's system plugins: the bridge is both of them.
 BUILT_IN_SYSTEM_PLUGINS = ("libgazebo_ros_paths_plugin.so", "libgazebo_ros_api_plugin.so")
@@ -106,6 +106,8 @@ def _run(prog: str, runner, gui: bool = None):
     except CommandLineError as error:
         print(f"{prog}: {error}", file=sys.stderr)
         sys.exit(1)
+    # The node reads the model path (a rospack run) once imported: rospack runs meanwhile.
+    prefetch_package_exports("gazebo_model_path")
     # Imported here, so that a refused command line and gzclient answer without loading PyBullet.
     from .node import main
     runner(main)

@@ -28,7 +28,7 @@ from . import loop_publishing
 from .plugins import loop_publisher, ros_time
 from .publisher_check import check_joint_state_publishers
 from .package_uris import resolve_package_uris
-from .processes import stop_on_signals
+from .processes import init_node, stop_on_signals
 from .plugins.registry import REGISTRY
 from .ros_parameters import RosParameters
 from .services import GazeboRosApi
@@ -223,7 +223,7 @@ def main():
     # them: at the default 5 ms a new subscriber at real_time_factor 0 waited up to half a second (bench).
     sys.setswitchinterval(0.001)
     verbose = "--verbose" in rospy.myargv(sys.argv)[1:]
-    rospy.init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO, disable_signals=True)
+    init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO, disable_signals=True)
     try:
         node = SimBridgeNode()
     except BridgeError as error:

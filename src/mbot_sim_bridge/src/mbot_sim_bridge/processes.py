@@ -1,6 +1,7 @@
 """Processes, for every package of the workspace: a private master on a free port and a clean stop of a launched
-process group (the demo, the benchmarks, the tests), and a process's own stop request on SIGINT/SIGTERM (the
-simulator node, ``./mbot sim``, the spawner and the unspawner)."""
+process group (the demo, the benchmarks, the tests), a process's own stop request on SIGINT/SIGTERM (the
+simulator node, ``./mbot sim``, the spawner and the unspawner), and rospy's init_node without its slow poll (the
+nodes on the way to the first /odom)."""
 import os
 import signal
 import socket
@@ -87,3 +88,26 @@ def stop_on_signals() -> threading.Event:
         signal.signal(signum, request_stop)
     return stop
 
+
+
+class _CappedSleeps:
+    """The time module as ``init_node`` below shows it to rospy.impl.init: sleeps of at most 1 ms."""
+
+    def __getattr__(self, name):
+        return getattr(time, name)
+
+    @staticmethod
+    def sleep(seconds: float):
+        time.sleep(min(seconds, 0.001))
+
+
+def init_node(name: str, **options):
+    """rospy.init_node with its wait for the master's registration polled every 1 ms: rospy/impl/init.py sleeps
+    0.1 s between checks, so about every other start waited up to 0.1 s after the node was registered."""
+    import rospy
+    import rospy.impl.init as rospy_init
+    rospy_init.time = _CappedSleeps()
+    try:
+        rospy.init_node(name, **options)
+    finally:
+        rospy_init.time = time

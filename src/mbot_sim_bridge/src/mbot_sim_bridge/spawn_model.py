@@ -15,6 +15,7 @@ from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
 from .core.geometry import pose_from_xyz_rpy
+from .processes import init_node
 
 SERVICE_POLL_SECONDS = 0.02
 
@@ -155,7 +156,7 @@ def spawn(arguments):
 
 def main():
     arguments = parse_arguments(rospy.myargv(sys.argv)[1:])
-    rospy.init_node("spawn_model", anonymous=True)
+    init_node("spawn_model", anonymous=True)
     try:
         spawn(arguments)
     except (SpawnError, rospy.ServiceException) as error:
