@@ -89,7 +89,6 @@ def stop_on_signals() -> threading.Event:
     return stop
 
 
-
 class _CappedSleeps:
     """The time module as ``init_node`` below shows it to rospy.impl.init: sleeps of at most 1 ms."""
 

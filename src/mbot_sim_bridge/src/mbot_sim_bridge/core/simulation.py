@@ -367,7 +367,7 @@ class Simulation:
 
         def on_step():
             if plugin in model.plugins:  # a failed plugin is removed from its model's few
-                # _guarded inlined: this runs after every physics step, where each call frame shows
+                # _guarded written out: this runs after every physics step, where each extra call costs
                 try:
                     plugin.on_step(step_size)
                 except Exception as error:  # the plugin boundary, as in _guarded
