@@ -164,8 +164,8 @@ class SpawnedRobot:
 
     def joint_state(self, joint_names: Sequence[str]) -> List[Tuple[float, float, float]]:
         """(position, velocity, applied effort) per named joint."""
-        states = self.client.getJointStates(self.body, [self.joint_index[name] for name in joint_names])
-        return [(state[0], state[1], state[3]) for state in states]
+        rows = self.joint_rows([self.joint_index[name] for name in joint_names])
+        return [(row[0], row[1], row[3]) for row in rows]
 
     def joint_rows(self, indices: Sequence[int]):
         """PyBullet's getJointStates rows (position, velocity, reaction wrench, applied effort) of joints by
