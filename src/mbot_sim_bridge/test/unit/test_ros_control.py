@@ -10,9 +10,11 @@ import pytest
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.ros_control.angles import normalize_angle, shortest_angular_distance_with_limits
 from mbot_sim_bridge.core.ros_control.control_toolbox import Pid
-from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveOdometry, SpeedLimiter
+from mbot_sim_bridge.core.ros_control.diff_drive_controller import (CommandSample, DiffDriveOdometry,
+                                                                    OdometrySample, SpeedLimiter)
 from mbot_sim_bridge.core.ros_control.joint_limits import JointLimits, apply_limit_params
 from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
+from mbot_sim_bridge.core.simulation import MAX_BATCH_SIM_SECONDS
 from mbot_sim_bridge.core.xml_values import parse_xml
 
 from conftest import expand_xacro
@@ -373,9 +375,10 @@ def test_a_joint_commanded_past_its_soft_limit_stops_at_it(interface, controller
 
 
 # -- the loop's batches ------------------------------------------------------------------------------------------
-def driven_mbot(urdf):
-    """The mbot with both controllers started at its first step (the switch waits by stepping), driving a circle."""
-    sim, spawned, plugin = simulate(urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+def driven_mbot(urdf, controllers=None):
+    """The mbot with both controllers (``controllers``, by default mbot_ros_control.yaml's) started at its first
+    step (the switch waits by stepping), driving a circle."""
+    sim, spawned, plugin = simulate(urdf, controllers or load_yaml(MBOT_YAML), "mbot", namespace="/")
     manager = plugin.manager
     names = ["joint_state_controller", "mobile_base_controller"]
     for name in names:
@@ -387,32 +390,90 @@ def driven_mbot(urdf):
 
 
 def test_controllers_update_between_the_steps_of_a_batch_as_single_steps_would(mbot_ros_control_urdf):
-    """The controllers run on every step inside the loop's batches, and the loop stops only where one publishes:
-    1,000 steps in one call publish at the same steps and end bit for bit where 1,000 single steps do."""
+    """The controllers run on every step inside the loop's batches and fill their outboxes there, so the loop
+    does not stop for them: 1,000 steps in one call send the same samples, stamped at the same steps, and end
+    bit for bit where 1,000 single steps do; each sample goes out at most MAX_BATCH_SIM_SECONDS after its step."""
     runs = []
     for batch in (1, 1000):
         sim, spawned, plugin, drive = driven_mbot(mbot_ros_control_urdf)
         try:
-            published, batches, update = [], recording_batches(sim), plugin.update
+            sent, delays, batches, update = [], [], recording_batches(sim), plugin.update
 
-            def record_update(now, update=update, plugin=plugin, published=published):
-                published.append((now, sorted(loaded.name for loaded in plugin.publish_now)))
+            def record_update(now, update=update, plugin=plugin, sent=sent):
+                for loaded in plugin.publish_now:
+                    sent.extend((stamp, loaded.name, sample) for stamp, sample in loaded.controller.outbox)
+                    delays.extend(now - stamp for stamp, _ in loaded.controller.outbox)
                 update(now)
             plugin.update = record_update
             for _ in range(1000 // batch):
                 sim.step(batch)
-            runs.append((published, batches, sim.engine.model_pose("mbot"),
+            runs.append((sent, batches, sim.engine.model_pose("mbot"),
                          (drive.odometry.x, drive.odometry.y, drive.odometry.heading)))
+            assert all(0.0 <= delay <= MAX_BATCH_SIM_SECONDS + 1e-9 for delay in delays), max(delays)
+            assert not any(loaded.controller.outbox for loaded in plugin.manager.controllers)
         finally:
             sim.close()
-    (single_published, single_batches, single_pose, single_odometry), (published, batches, pose, odometry) = runs
+    (single_sent, single_batches, single_pose, single_odometry), (sent, batches, pose, odometry) = runs
     assert sum(batches) == sum(single_batches) == 1000
-    assert len(single_batches) == 1000 and len(batches) <= 200, batches
-    assert published == single_published
+    # Batches of the loop's longest (10 ms, 10 steps): the controllers end none.
+    assert len(single_batches) == 1000 and len(batches) <= 101, batches
+    assert sent == single_sent
     for name in ("joint_state_controller", "mobile_base_controller"):  # 50 Hz each
-        assert 49 <= sum(name in names for _, names in published) <= 51
+        assert 49 <= sum(entry[1] == name for entry in sent) <= 51
     assert pose == single_pose and odometry == single_odometry
     assert odometry[2] > 0.2  # it turned (0.5 rad/s until cmd_vel_timeout, 0.5 s)
+
+
+def sent_samples(plugin):
+    """(stamp, controller name, sample) of everything the controllers' outboxes send from now on."""
+    sent, update = [], plugin.update
+
+    def record_update(now):
+        for loaded in plugin.publish_now:
+            sent.extend((stamp, loaded.name, sample) for stamp, sample in loaded.controller.outbox)
+        update(now)
+    plugin.update = record_update
+    return sent
+
+
+def test_cmd_vel_out_is_filled_on_every_control_cycle_without_stopping_the_loop(mbot_ros_control_urdf):
+    """publish_cmd: the limited command of each cycle (here ramping at max_acceleration 1.8 m/s²), stamped at its
+    step; the loop still steps in its longest batches."""
+    controllers = load_yaml(MBOT_YAML)
+    controllers["mobile_base_controller"]["publish_cmd"] = True
+    sim, spawned, plugin, drive = driven_mbot(mbot_ros_control_urdf, controllers)
+    try:
+        drive.set_command(1.0, 0.0, sim.sim_time)
+        start, sent, batches = sim.sim_time, sent_samples(plugin), recording_batches(sim)
+        sim.step(100)
+        commands = [(stamp, sample) for stamp, _, sample in sent if isinstance(sample, CommandSample)]
+        assert [stamp for stamp, _ in commands] == pytest.approx([start + 0.001 * (k + 1) for k in range(100)])
+        ramp = [sample.linear - before.linear for (_, before), (_, sample) in zip(commands, commands[1:])]
+        assert ramp == pytest.approx([1.8 * 0.001] * 99)
+        assert 4 <= sum(isinstance(sample, OdometrySample) for _, _, sample in sent) <= 5  # 50 Hz over 0.1 s
+        assert len(batches) <= 11, batches
+    finally:
+        sim.close()
+
+
+def test_the_pid_controllers_state_is_sampled_every_tenth_update_at_its_own_step():
+    sim, _, plugin = simulate(expand_xacro_arm("Effort"), load_yaml(os.path.join(ROBOTS, "config", "arm_effort.yaml")),
+                              "arm")
+    try:
+        manager = plugin.manager
+        assert manager.load("elbow_position_controller", plugin.urdf)
+        switch_stepping(sim, manager, ["elbow_position_controller"])
+        manager.find("elbow_position_controller").controller.set_command(0.5)
+        start, sent, batches = sim.sim_time, sent_samples(plugin), recording_batches(sim)
+        sim.step(200)
+        stamps = [stamp for stamp, _, _ in sent]
+        assert len(stamps) == 20 and [b - a for a, b in zip(stamps, stamps[1:])] == pytest.approx([0.01] * 19)
+        assert start < stamps[0] <= start + 0.01
+        last = sent[-1][2]
+        assert last.set_point == 0.5 and last.error == pytest.approx(last.set_point - last.process_value)
+        assert len(batches) <= 21, batches
+    finally:
+        sim.close()
 
 
 def test_a_controller_plugin_failing_within_a_batch_is_disabled_for_the_rest_of_it(mbot_ros_control_urdf, caplog):

@@ -7,9 +7,11 @@ are written after every physics step. The ROS plugin (``plugins/gazebo_ros_contr
 from ``robotParam``, the parameters, the controllers' ROS classes and the services.
 
 The controllers' messages are published from ``update(now)``, which the Simulation calls after /clock
-(``timer`` is due whenever a running controller's publish time has come), so none is stamped ahead of the
-clock; their control runs in ``on_step``, between the physics steps of a batch, so the loop stops only where a
-controller publishes (``Controller.steps_until_publish``).
+(``timer`` is due whenever a controller has filled its ``outbox`` or a running one's publish time has come), so
+none is stamped ahead of the clock. Their control runs in ``on_step``, between the physics steps of a batch.
+What a controller fills at the step it is due, as upstream's realtime publishers are filled (joint states,
+odometry, the PID controllers' state), keeps that step's values and stamp and goes out at the loop's next stop;
+the loop stops only where a controller publishes from its state at a stop (``Controller.steps_until_publish``).
 """
 import sys
 from typing import List
@@ -54,8 +56,8 @@ class _PublishSchedule:
         self.plugin = plugin
 
     def due(self, now: float) -> bool:
-        due = [loaded for loaded in self.plugin.manager.controllers
-               if loaded.controller.state == "running" and loaded.controller.publish_due(now)]
+        due = [loaded for loaded in self.plugin.manager.controllers if loaded.controller.outbox or (
+               loaded.controller.state == "running" and loaded.controller.publish_due(now))]
         self.plugin.publish_now = due
         return bool(due)
 
@@ -117,6 +119,7 @@ class GazeboRosControlPlugin(Plugin):
         self.publish_now: List = []
         now = context.simulation.sim_time
         self.last_update = self.last_write = now
+        self._engine = context.engine  # the sim time without the Simulation's property, after every step
         self.e_stop = False
         self._last_e_stop = False
 
@@ -137,7 +140,7 @@ class GazeboRosControlPlugin(Plugin):
         return self.manager.load(name, self.urdf)
 
     def on_step(self, step_size: float):
-        now = self.context.simulation.sim_time
+        now = self._engine.sim_time
         self.hw.e_stop_active = self.e_stop
         period = now - self.last_update
         if period >= self.control_period - _EPSILON:
@@ -154,7 +157,9 @@ class GazeboRosControlPlugin(Plugin):
         self.last_write = now
 
     def update(self, now: float):
-        """Publish for the controllers whose time has come (the ROS plugin does the publishing)."""
+        """Publish for the controllers whose time has come (the ROS plugin does the publishing, then calls this)."""
+        for loaded in self.publish_now:
+            loaded.controller.outbox.clear()
         self.publish_now = []
 
     def reset(self, now: float):

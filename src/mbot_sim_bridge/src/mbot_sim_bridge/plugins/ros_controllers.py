@@ -1,10 +1,12 @@
 """The ROS side of the ros_controllers (``core/controllers.py``): their topics, under the controller's namespace
 (``<robot namespace>/<controller name>``) as upstream's controller NodeHandle puts them.
 
-Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock. The single-joint PID
-controllers publish control_msgs/JointControllerState on ``state`` every tenth update, as upstream. The
-trajectory and gripper controllers serve their actions with actionlib's ActionServer: a goal's outcome found by
-the update goes out with the next publish, one decided in a ROS callback (preemption, cancel) at once.
+Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock, at the stop of the loop
+where the controller is due, and sends what its updates filled into the ``outbox``, each with its own update's
+stamp (the joint states, the odometry, ``cmd_vel_out``; the single-joint PID controllers' control_msgs/
+JointControllerState on ``state`` every tenth update, as upstream). The trajectory and gripper controllers
+serve their actions with actionlib's ActionServer: a goal's outcome found by the update goes out with the next
+publish, one decided in a ROS callback (preemption, cancel) at once.
 """
 import math
 
@@ -22,15 +24,16 @@ from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from ..core.ros_control import CORE_CONTROLLERS
-from ..core.ros_control.diff_drive_controller import DiffDriveController
+from ..core.ros_control.diff_drive_controller import CommandSample, DiffDriveController, OdometrySample
 from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.ros_control.joint_trajectory_controller import (ABORTED, SUCCEEDED, JointTolerance, JointTrajectory,
                                                             JointTrajectoryController, TrajectoryGoal,
                                                             TrajectoryPoint)
+from ..core.ros_control.pid_controllers import StateSampling
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame
-from . import loop_publisher, resolve_in_namespace
+from . import loop_publisher, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance
 
 
@@ -41,10 +44,11 @@ class RosJointStateController(JointStateController):
         self.publisher = loop_publisher(resolve_in_namespace(root, "joint_states"), JointState)
 
     def publish(self, stamp):
-        message = JointState()
-        message.header.stamp = stamp
-        message.name, message.position, message.velocity, message.effort = self.states()
-        self.publisher.publish(message)
+        for time, states in self.outbox:
+            message = JointState()
+            message.header.stamp = ros_time(time)
+            message.name, message.position, message.velocity, message.effort = states
+            self.publisher.publish(message)
 
     def close(self):
         self.publisher.unregister()
@@ -59,7 +63,6 @@ class RosDiffDriveController(DiffDriveController):
         self.odom_publisher = loop_publisher(namespace + "/odom", Odometry)
         self.tf_publisher = loop_publisher("/tf", TFMessage)
         self.cmd_publisher = loop_publisher(namespace + "/cmd_vel_out", TwistStamped) if self.publish_cmd else None
-        self._cmd_pending = self._odometry_due = False
         self.subscriber = TrackedSubscriber(namespace + "/cmd_vel", Twist, self._on_command)
 
     def _on_command(self, message: Twist):
@@ -68,29 +71,17 @@ class RosDiffDriveController(DiffDriveController):
         if complaint:
             rospy.logerr_throttle(1.0, f"{self.name}: {complaint}")
 
-    def update(self, now, period):
-        super().update(now, period)
-        self._cmd_pending = self.cmd_publisher is not None
-
-    def publish_due(self, now):
-        # cmd_vel_out goes out on every control cycle, as upstream; the odometry at publish_rate.
-        odometry_due = super().publish_due(now)
-        self._odometry_due = odometry_due
-        return odometry_due or self._cmd_pending
-
-    def steps_until_publish(self, now, step_size):
-        return 1 if self.cmd_publisher is not None else super().steps_until_publish(now, step_size)
-
     def publish(self, stamp):
-        if self._cmd_pending:
-            self._cmd_pending = False
-            message = TwistStamped()
-            message.header.stamp = stamp
-            message.twist.linear.x, message.twist.angular.z = self.limited
-            self.cmd_publisher.publish(message)
-        if not self._odometry_due:
-            return
-        odometry = self.odometry
+        for time, sample in self.outbox:
+            if isinstance(sample, CommandSample):
+                message = TwistStamped()
+                message.header.stamp = ros_time(time)
+                message.twist.linear.x, message.twist.angular.z = sample.linear, sample.angular
+                self.cmd_publisher.publish(message)
+            else:
+                self._publish_odometry(ros_time(time), sample)
+
+    def _publish_odometry(self, stamp, odometry: OdometrySample):
         message = Odometry()
         message.header.stamp = stamp
         message.header.frame_id = self.odom_frame
@@ -122,7 +113,7 @@ class _CommandTopic:
 
     def _subscribe(self, namespace, group):
         self.state_publisher = (loop_publisher(namespace + "/state", JointControllerState)
-                                if hasattr(self, "state_sample") else None)
+                                if isinstance(self, StateSampling) else None)
         message_type = Float64MultiArray if group else Float64
         self.subscriber = TrackedSubscriber(namespace + "/command", message_type, self._on_command)
 
@@ -135,10 +126,10 @@ class _CommandTopic:
             rospy.logerr(complaint)
 
     def publish(self, stamp):
-        message = JointControllerState(**self.state_sample._asdict())
-        message.header.stamp = stamp
-        self.state_sample = None
-        self.state_publisher.publish(message)
+        for time, sample in self.outbox:
+            message = JointControllerState(**sample._asdict())
+            message.header.stamp = ros_time(time)
+            self.state_publisher.publish(message)
 
     def close(self):
         self.subscriber.unregister()

@@ -1,10 +1,11 @@
 """controller_interface::Controller<T>, and reading a controller's parameters as NodeHandle::param does."""
 import math
 import sys
-from typing import List, Sequence
+from dataclasses import dataclass
+from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 from ..log import get_logger, warn_once
-from .controller_manager import LoadContext
+from ..robot_model import RobotModel
 from .hardware_interface import JOINT_STATE
 from .robot_hw_sim import DefaultRobotHWSim
 
@@ -32,17 +33,31 @@ def param(params: dict, path: str, default=_MISSING, kind: type = float, where: 
     return None if default is _MISSING else default
 
 
+@dataclass
+class LoadContext:
+    """What a controller gets besides its parameters: the robot's URDF (None if it could not be read) and its
+    parameter namespace (for messages)."""
+    urdf: Optional[RobotModel]
+    namespace: str
+    clock: Callable[[], float]  # the sim time (s), readable from any thread
+
+
 class Controller:
     """controller_interface::Controller<T>: the state machine and the claimed resources."""
 
     INTERFACE = JOINT_STATE
 
-    def __init__(self, name: str, hw: DefaultRobotHWSim, params: dict, context: "LoadContext"):
+    def __init__(self, name: str, hw: DefaultRobotHWSim, params: dict, context: LoadContext):
         self.name = name
         self.hw = hw
         self.params = params
         self.state = "initialized"
         self.claimed: List[str] = []
+        # What update() filled for the ROS layer at the step it was due, as (sim time, sample): upstream's
+        # controllers fill their realtime publishers' messages in update, and another thread sends them. The
+        # loop sends these at its next stop (at most MAX_BATCH_SIM_SECONDS later), so they need no stop of their
+        # own; the plugin then empties the list.
+        self.outbox: List[Tuple[float, Any]] = []
 
     def handle(self, joint: str):
         handle = self.hw.handle(joint, self.INTERFACE)
@@ -78,13 +93,14 @@ class Controller:
         pass
 
     def publish_due(self, now: float) -> bool:
-        """Whether the ROS layer has something to publish now (the bridge publishes after /clock)."""
+        """Whether the ROS layer has something to publish now from the controller's state at this stop of the
+        loop (the bridge publishes after /clock); ``outbox`` holds what was filled at earlier steps."""
         return False
 
     def steps_until_publish(self, now: float, step_size: float) -> int:
         """Physics steps until ``publish_due`` can next be true: the loop runs the updates between the steps of
-        its batches and stops there. A controller that publishes says when; what an update makes at any step (a
-        goal's end) goes out when the loop next stops."""
+        its batches and stops there. A controller that publishes from a stop says when; what an update makes at
+        any step (a goal's end, the ``outbox``) goes out when the loop next stops."""
         return sys.maxsize
 
     def restart_clock(self, now: float):

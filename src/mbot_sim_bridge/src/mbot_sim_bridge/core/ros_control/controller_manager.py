@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..log import get_logger
-from ..robot_model import RobotModel
+from .controller_interface import Controller, LoadContext
 from .hardware_interface import INTERFACE_TYPES, HardwareInterfaceError
 from .robot_hw_sim import DefaultRobotHWSim
 
@@ -17,19 +17,10 @@ class ControllerInitError(Exception):
 
 
 @dataclass
-class LoadContext:
-    """What a controller gets besides its parameters: the robot's URDF (None if it could not be read) and its
-    parameter namespace (for messages)."""
-    urdf: Optional[RobotModel]
-    namespace: str
-    clock: Callable[[], float]  # the sim time (s), readable from any thread
-
-
-@dataclass
 class LoadedController:
     name: str
     type: str
-    controller: object  # a controller_interface.Controller
+    controller: Controller
     claimed: List[Tuple[str, List[str]]]  # (hardware interface type, resources)
 
     @property
@@ -56,6 +47,8 @@ class ControllerManager:
         self.get_params = get_params
         self.namespace = namespace
         self.controllers: List[LoadedController] = []  # replaced, never mutated: the loop reads it without lock
+        # The update methods of the running controllers that have one, in load order: the loop's every-step work.
+        self._updates: List[Callable[[float, float], None]] = []
         self._lock = threading.RLock()
         self._switch_request: Optional[Tuple[list, list, threading.Event]] = None
 
@@ -198,19 +191,18 @@ class ControllerManager:
             for loaded in self.controllers:
                 loaded.controller.close()
             self.controllers = []
+            self._updates = []
 
     # -- loop side ---------------------------------------------------------------------------------------
     def update(self, now: float, period: float, reset_controllers: bool = False):
         """Every running controller's update, then a pending switch, as ControllerManager::update."""
-        controllers = self.controllers
         if reset_controllers:
-            for loaded in controllers:
+            for loaded in self.controllers:
                 if loaded.state == "running":
                     loaded.controller.stop_request(now)
                     loaded.controller.start_request(now)
-        for loaded in controllers:
-            if loaded.controller.state == "running":
-                loaded.controller.update(now, period)
+        for update in self._updates:
+            update(now, period)
         request = self._switch_request
         if request is not None:
             stop_list, start_list, done = request
@@ -219,6 +211,8 @@ class ControllerManager:
                     loaded.controller.stop_request(now)
             for loaded in start_list:
                 loaded.controller.start_request(now)
+            self._updates = [loaded.controller.update for loaded in self.controllers
+                             if loaded.state == "running" and type(loaded.controller).update is not Controller.update]
             self._switch_request = None
             done.set()
 

@@ -1,18 +1,35 @@
 """diff_drive_controller/DiffDriveController: wheels as names or lists, geometry from the parameters or the
 URDF, multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact arc /
-Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``."""
+Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``; the odometry (at ``publish_rate``) and
+``cmd_vel_out`` (with ``publish_cmd``, every cycle) filled into the ``outbox``."""
 import collections
 import math
-from typing import List, Optional, Tuple
+import operator
+from typing import List, NamedTuple, Optional
 
 from ..log import get_logger, warn_once
 from ..robot_model import RobotModel
 from .controller_manager import ControllerInitError
 from .hardware_interface import VELOCITY
-from ..clock import steps_until_past
 from .controller_interface import Controller, param
 
 _logger = get_logger(__name__)
+_position = operator.attrgetter("position")  # of a joint handle
+
+
+class OdometrySample(NamedTuple):
+    """nav_msgs/Odometry's (and the odom TF's) values at a publish time of the odometry."""
+    x: float
+    y: float
+    heading: float
+    linear: float
+    angular: float
+
+
+class CommandSample(NamedTuple):
+    """cmd_vel_out's values: the command after the speed limiter."""
+    linear: float
+    angular: float
 
 
 class SpeedLimiter:
@@ -87,11 +104,8 @@ class DiffDriveOdometry:
         if dt < 0.0001:
             return False  # too short an interval to estimate speeds
         self.timestamp = now
-        self.linear, self.angular = self._rolling_means(linear / dt, angular / dt)
-        return True
-
-    def _rolling_means(self, linear: float, angular: float) -> Tuple[float, float]:
-        """boost's rolling_mean of each speed over the last ``window`` updates, kept as running sums."""
+        # boost's rolling_mean of each speed over the last ``window`` updates, kept as running sums
+        linear, angular = linear / dt, angular / dt
         speeds = self._speeds
         speeds.append((linear, angular))
         self._linear_sum += linear
@@ -101,7 +115,8 @@ class DiffDriveOdometry:
             self._linear_sum -= old_linear
             self._angular_sum -= old_angular
         count = len(speeds)
-        return self._linear_sum / count, self._angular_sum / count
+        self.linear, self.angular = self._linear_sum / count, self._angular_sum / count
+        return True
 
     def update_open_loop(self, linear: float, angular: float, now: float):
         self.linear, self.angular = linear, angular
@@ -200,7 +215,6 @@ class DiffDriveController(Controller):
         self._command = (0.0, 0.0, -math.inf)
         self.last0 = self.last1 = (0.0, 0.0)
         self.last_publish = 0.0
-        self.limited = (0.0, 0.0)
 
     def _geometry_from_urdf(self, urdf: Optional[RobotModel], left: str, right: str):
         if self.wheel_separation is not None and self.wheel_radius is not None:
@@ -263,22 +277,29 @@ class DiffDriveController(Controller):
     def update(self, now, period):
         # Upstream re-applies the multipliers every cycle for dynamic_reconfigure, which is not served here:
         # they are applied once, at init.
+        odometry = self.odometry
         if self.open_loop:
-            self.odometry.update_open_loop(self.last0[0], self.last0[1], now)
+            odometry.update_open_loop(self.last0[0], self.last0[1], now)
         else:
             count = len(self.left)
-            left = sum([joint.position for joint in self.left]) / count
-            right = sum([joint.position for joint in self.right]) / count
+            left = sum(map(_position, self.left)) / count
+            right = sum(map(_position, self.right)) / count
             if math.isnan(left) or math.isnan(right):
                 return
-            self.odometry.update(left, right, now)
+            odometry.update(left, right, now)
+        if self.last_publish + 1.0 / self.publish_rate < now:
+            self.last_publish += 1.0 / self.publish_rate
+            self.outbox.append((now, OdometrySample(odometry.x, odometry.y, odometry.heading, odometry.linear,
+                                                    odometry.angular)))
         linear, angular, stamp = self._command
         if now - stamp > self.cmd_vel_timeout:
             linear = angular = 0.0
         linear = self.limiter_linear.limit(linear, self.last0[0], self.last1[0], period)
         angular = self.limiter_angular.limit(angular, self.last0[1], self.last1[1], period)
-        self.last1, self.last0 = self.last0, (linear, angular)
-        self.limited = (linear, angular)
+        self.last1 = self.last0
+        self.last0 = (linear, angular)
+        if self.publish_cmd:  # cmd_vel_out: every control cycle, as upstream
+            self.outbox.append((now, CommandSample(linear, angular)))
         separation, left_radius, right_radius = self.wheel_params_applied
         left_speed = (linear - angular * separation / 2.0) / left_radius
         right_speed = (linear + angular * separation / 2.0) / right_radius
@@ -286,12 +307,3 @@ class DiffDriveController(Controller):
             joint.command = left_speed
         for joint in self.right:
             joint.command = right_speed
-
-    def publish_due(self, now):
-        if self.last_publish + 1.0 / self.publish_rate < now:
-            self.last_publish += 1.0 / self.publish_rate
-            return True
-        return False
-
-    def steps_until_publish(self, now, step_size):
-        return steps_until_past(self.last_publish + 1.0 / self.publish_rate, now, step_size)

@@ -1,12 +1,10 @@
-"""joint_state_controller/JointStateController: ``publish_rate`` (required), ``joints``, ``extra_joints``. The ROS
-layer (``plugins/ros_controllers.py``) publishes."""
-import sys
+"""joint_state_controller/JointStateController: ``publish_rate`` (required), ``joints``, ``extra_joints``. Its
+update fills the ``outbox`` at the publish rate; the ROS layer (``plugins/ros_controllers.py``) publishes."""
 from typing import List
 
 from ..log import get_logger
 from .controller_manager import ControllerInitError
 from .hardware_interface import JOINT_STATE
-from ..clock import steps_until_past
 from .controller_interface import Controller, param
 
 _logger = get_logger(__name__)
@@ -69,16 +67,11 @@ class JointStateController(Controller):
             if self.state == "running":
                 self.starting(now)
 
-    def publish_due(self, now):
+    def update(self, now, period):
+        # Upstream checks its publish time in update and fills its realtime publisher there.
         if self.publish_rate > 0 and self.last_publish + 1.0 / self.publish_rate < now:
             self.last_publish += 1.0 / self.publish_rate
-            return True
-        return False
-
-    def steps_until_publish(self, now, step_size):
-        if not self.publish_rate > 0:  # NaN included: it never publishes
-            return sys.maxsize
-        return steps_until_past(self.last_publish + 1.0 / self.publish_rate, now, step_size)
+            self.outbox.append((now, self.states()))
 
     def states(self):
         """(names, positions, velocities, efforts) with the extra joints' fixed values last."""

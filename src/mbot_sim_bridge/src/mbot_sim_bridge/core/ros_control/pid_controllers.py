@@ -1,8 +1,8 @@
 """The PID controllers of effort_controllers and velocity_controllers: JointPositionController,
 JointVelocityController, JointGroupPositionController (control_toolbox's Pid from ``pid/p i d i_clamp``).
 
-The single-joint ones take a sample of their state every tenth update, the first included, as upstream fills
-its control_msgs/JointControllerState (``state``) then; the ROS layer publishes it."""
+The single-joint ones put a sample of their state into the ``outbox`` every tenth update, the first included, as
+upstream fills its control_msgs/JointControllerState (``state``) then; the ROS layer publishes it."""
 from typing import NamedTuple, Optional
 
 from ..robot_model import RobotModel
@@ -68,25 +68,19 @@ class StateSample(NamedTuple):
     antiwindup: bool
 
 
-class _StateSampling:
-    """Mixed into a single-joint PID controller: ``state_sample`` every STATE_EVERY_UPDATES updates."""
+class StateSampling:
+    """Mixed into a single-joint PID controller: a StateSample into the ``outbox`` every STATE_EVERY_UPDATES
+    updates."""
 
-    def _sample(self, set_point: float, process_value: float, period: float):
+    def _sample(self, now: float, set_point: float, process_value: float, period: float):
         if self.updates % STATE_EVERY_UPDATES == 0:
             pid = self.pid
-            self.state_sample = StateSample(set_point, process_value, self.joint.velocity, self.error, period,
-                                            self.output, pid.p, pid.i, pid.d, pid.i_max, pid.antiwindup)
+            self.outbox.append((now, StateSample(set_point, process_value, self.joint.velocity, self.error, period,
+                                                 self.output, pid.p, pid.i, pid.d, pid.i_max, pid.antiwindup)))
         self.updates += 1
 
-    def publish_due(self, now):
-        return self.state_sample is not None
 
-    def steps_until_publish(self, now, step_size):
-        # The update that samples is at least that many steps away (exactly, when controlPeriod is the step).
-        return 1 if self.state_sample is not None else (-self.updates) % STATE_EVERY_UPDATES + 1
-
-
-class PidPositionController(_StateSampling, Controller):
+class PidPositionController(StateSampling, Controller):
     """effort_controllers/JointPositionController (INTERFACE EFFORT) and velocity_controllers/
     JointPositionController (INTERFACE VELOCITY): PID on the position error, output as the joint's command."""
 
@@ -100,7 +94,7 @@ class PidPositionController(_StateSampling, Controller):
         self.target = 0.0
         self.target_velocity = None
         self.error = self.output = 0.0
-        self.updates, self.state_sample = 0, None
+        self.updates = 0
 
     def set_command(self, position: float, velocity: Optional[float] = None):
         if self.finite_command([self.joint.name] * 2, [position, 0.0 if velocity is None else velocity]):
@@ -116,10 +110,10 @@ class PidPositionController(_StateSampling, Controller):
         velocity_error = None if self.target_velocity is None else self.target_velocity - self.joint.velocity
         self.output = self.pid.compute(self.error, period, velocity_error)
         self.joint.command = self.output
-        self._sample(target, self.joint.position, period)
+        self._sample(now, target, self.joint.position, period)
 
 
-class EffortVelocityController(_StateSampling, Controller):
+class EffortVelocityController(StateSampling, Controller):
     """effort_controllers/JointVelocityController: PID on the velocity error, output as effort."""
 
     INTERFACE = EFFORT
@@ -131,7 +125,7 @@ class EffortVelocityController(_StateSampling, Controller):
         self.pid = _pid(params, "pid", self.namespace)
         self.target = 0.0
         self.error = self.output = 0.0
-        self.updates, self.state_sample = 0, None
+        self.updates = 0
 
     def set_command(self, velocity: float):
         if self.finite_command([self.joint.name], [velocity]):
@@ -145,7 +139,7 @@ class EffortVelocityController(_StateSampling, Controller):
         self.error = self.target - self.joint.velocity
         self.output = self.pid.compute(self.error, period)
         self.joint.command = self.output
-        self._sample(self.target, self.joint.velocity, period)
+        self._sample(now, self.target, self.joint.velocity, period)
 
 
 class EffortGroupPositionController(ForwardJointGroupCommandController):

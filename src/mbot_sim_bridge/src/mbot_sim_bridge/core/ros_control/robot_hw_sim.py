@@ -8,7 +8,7 @@ handles; ``gazebo_ros_control/pid_gains/<joint>`` turns position and velocity jo
 joints; the e-stop."""
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence
 
 from ..errors import ConfigError
 from ..log import get_logger, info_once, warn_once
@@ -44,8 +44,14 @@ class SimJoint:
     command: float = 0.0
     previous_command: float = math.nan  # position saturation's memory
     previous_velocity_command: float = 0.0  # velocity saturation's memory
-    # The last motor setting given to the engine: (the body's load count, mode, value).
-    sent: Optional[Tuple[int, str, float]] = field(default=None, repr=False)
+    # The last motor setting given to the engine: the body's load count (0: none since the last reset) and value.
+    sent_loads: int = field(default=0, repr=False)
+    sent_value: float = field(default=0.0, repr=False)
+
+    @property
+    def motor(self) -> str:
+        """The engine's motor mode: a PID turns a position or velocity joint into an effort one."""
+        return "effort" if self.pid is not None else _COMMAND_KIND[self.interface]
 
     @property
     def lower(self) -> float:
@@ -129,6 +135,8 @@ class DefaultRobotHWSim:
                     info_once(_logger, f"{label}: {why}: joint '{joint_name}' is driven directly ({drive})")
             self.joints[joint_name] = SimJoint(joint_name, interface, joint_type, limits, pid, soft_limits)
         self.names = list(self.joints)
+        # (joint, motor mode, what the engine can carry out in that mode) for write_sim, after every step
+        self._motors = [(joint, joint.motor, _ENGINE_BOUND[joint.motor]) for joint in self.joints.values()]
         self._indices = [robot.joint_index[name] for name in self.names]
 
     def _check_limits(self, joint: str, interface: str, limits: Optional[JointLimits],
@@ -177,21 +185,49 @@ class DefaultRobotHWSim:
         return True
 
     def write_sim(self, period: float):
-        """writeSim: e-stop, limit saturation, then each joint's motor; the engine is told only of changes."""
-        if self.e_stop_active:
+        """writeSim: e-stop, limit saturation, then each joint's motor; the engine is told only of changes.
+        Written as one pass over the joints with the motor settings inline: it runs after every physics step."""
+        e_stop = self.e_stop_active
+        if e_stop:
             if not self._last_e_stop_active:
                 self._held_positions = {name: joint.position for name, joint in self.joints.items()}
                 self._last_e_stop_active = True
         else:
             self._last_e_stop_active = False
-        for joint in self.joints.values():
-            if joint.interface == POSITION and self.e_stop_active:
+        loads = self.robot.loads
+        for joint, motor, bound in self._motors:
+            if e_stop and joint.interface == POSITION:
                 joint.command = self._held_positions.get(joint.name, joint.position)
             if not math.isfinite(joint.command):
                 joint.command = self._finite(joint, _COMMAND_KIND[joint.interface], joint.command)
             if joint.limits is not None:
                 self._saturate(joint, period)
-            self._drive(joint, period)
+            if joint.pid is not None:
+                value = self._pid_effort(joint, period)
+            elif e_stop and motor != "position":
+                value = 0.0
+            else:
+                value = joint.command
+            if not -bound <= value <= bound:  # value is finite: the checks above have seen to that
+                value = self._clamped_to_engine(joint, motor, value)
+            # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is
+            # not sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's
+            # SetForce).
+            if motor == "effort":
+                self.robot.set_joint_effort(joint.name, value)
+            elif value != joint.sent_value or loads != joint.sent_loads:
+                joint.sent_loads, joint.sent_value = loads, value
+                self._set_motor(joint, motor, value)
+
+    def _set_motor(self, joint: SimJoint, motor: str, value: float):
+        """A new setting of a position or velocity motor."""
+        if motor == "position":
+            # Gazebo teleports the joint (SetPosition) regardless of load; Bullet's position servo with an
+            # unbounded force is the stable equivalent that still lets contacts act.
+            self.robot.set_joint_position(joint.name, value, UNBOUNDED_EFFORT)
+        else:
+            limit = joint.effort_limit
+            self.robot.set_joint_velocity(joint.name, value, limit if math.isfinite(limit) else UNBOUNDED_EFFORT)
 
     def _saturate(self, joint: SimJoint, period: float):
         if joint.soft_limits is not None:
@@ -260,29 +296,22 @@ class DefaultRobotHWSim:
         if joint.interface == POSITION:
             joint.previous_command = joint.command
 
-    def _drive(self, joint: SimJoint, period: float):
-        e_stop = self.e_stop_active
-        if joint.pid is not None:
-            if joint.interface == POSITION:
-                if joint.joint_type == "revolute":
-                    error = shortest_angular_distance_with_limits(joint.position, joint.command, joint.lower,
-                                                                  joint.upper)
-                elif joint.joint_type == "continuous":
-                    error = shortest_angular_distance(joint.position, joint.command)
-                else:
-                    error = joint.command - joint.position
+    def _pid_effort(self, joint: SimJoint, period: float) -> float:
+        """The effort a PID-driven position or velocity joint gets (on e-stop: towards the held position or zero
+        speed), within the joint's effort limit."""
+        if joint.interface == POSITION:
+            if joint.joint_type == "revolute":
+                error = shortest_angular_distance_with_limits(joint.position, joint.command, joint.lower, joint.upper)
+            elif joint.joint_type == "continuous":
+                error = shortest_angular_distance(joint.position, joint.command)
             else:
-                error = -joint.velocity if e_stop else joint.command - joint.velocity
-            limit = joint.effort_limit
-            # The one value not checked by write_sim: gains like 1e308 overflow it, past an unbounded limit.
-            effort = self._finite(joint, "effort", joint.pid.compute(error, period))
-            self._send(joint, "effort", clamp(effort, -limit, limit))
-        elif joint.interface == EFFORT:
-            self._send(joint, "effort", 0.0 if e_stop else joint.command)
-        elif joint.interface == POSITION:
-            self._send(joint, "position", joint.command)
+                error = joint.command - joint.position
         else:
-            self._send(joint, "velocity", 0.0 if e_stop else joint.command)
+            error = -joint.velocity if self.e_stop_active else joint.command - joint.velocity
+        limit = joint.effort_limit
+        # The one value not checked by write_sim: gains like 1e308 overflow it, past an unbounded limit.
+        effort = self._finite(joint, "effort", joint.pid.compute(error, period))
+        return clamp(effort, -limit, limit)
 
     def _finite(self, joint: SimJoint, what: str, value: float) -> float:
         """``value``, or the joint held (at its position, or at zero speed or effort) when it is NaN or inf:
@@ -302,29 +331,10 @@ class DefaultRobotHWSim:
                            f"{bound:g}; clamped")
         return math.copysign(bound, value)
 
-    def _send(self, joint: SimJoint, mode: str, value: float):
-        if abs(value) > _ENGINE_BOUND[mode]:  # value is finite: write_sim and _drive have seen to that
-            value = self._clamped_to_engine(joint, mode, value)
-        # Bullet keeps a velocity or position motor's setting until it is changed, so an unchanged one is not
-        # sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's SetForce).
-        setting = (self.robot.loads, mode, value)
-        if mode != "effort" and joint.sent == setting:
-            return
-        joint.sent = setting
-        limit = joint.effort_limit if math.isfinite(joint.effort_limit) else UNBOUNDED_EFFORT
-        if mode == "effort":
-            self.robot.set_joint_effort(joint.name, value)
-        elif mode == "position":
-            # Gazebo teleports the joint (SetPosition) regardless of load; Bullet's position servo with an
-            # unbounded force is the stable equivalent that still lets contacts act.
-            self.robot.set_joint_position(joint.name, value, UNBOUNDED_EFFORT)
-        else:
-            self.robot.set_joint_velocity(joint.name, value, limit)
-
     def forget_motors(self):
         """After a reset the engine's motors may have changed; send every setting again."""
         for joint in self.joints.values():
-            joint.sent = None
+            joint.sent_loads = 0
 
 
 # <robotSimType> -> class; a robot's own hardware simulation is a class with the same interface and a line here.
