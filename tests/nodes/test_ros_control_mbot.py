@@ -8,6 +8,7 @@ import math
 import threading
 import unittest
 
+import rosgraph
 import rospy
 import rostest
 from controller_manager_msgs.srv import (ListControllers, ListControllerTypes, LoadController, SwitchController,
@@ -80,6 +81,14 @@ class RosControlMbot(unittest.TestCase):
         end = self.sim.wait_sim_time(MEASURE_SECONDS)
         self.command(0.0, 0.0)
         return motion_between(start, end)
+
+    def test_0_the_spawner_stops_taking_the_clock_once_the_controllers_run(self):
+        def nodes(kind, topic):
+            publishers, subscribers, _ = rosgraph.Master(rospy.get_name()).getSystemState()
+            return next((names for name, names in (publishers if kind == "pub" else subscribers) if name == topic), [])
+        self.assertIn("/controller_spawner", nodes("pub", "/rosout"))  # it runs, waiting for its end
+        wait_for(lambda: "/controller_spawner" not in nodes("sub", "/clock"), what="the spawner to unsubscribe /clock")
+        self.assertIn(rospy.get_name(), nodes("sub", "/clock"))  # as every other node under /use_sim_time
 
     def test_1_tracks_linear_and_angular_speed(self):
         for linear, angular in ((0.2, 0.0), (-0.2, 0.0), (0.0, 0.5), (0.0, -1.0)):

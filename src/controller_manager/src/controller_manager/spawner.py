@@ -16,6 +16,7 @@ import time
 
 import rosparam
 import rospy
+import rospy.impl.simtime
 import yaml
 from controller_manager_msgs.srv import LoadController, SwitchController, SwitchControllerRequest, UnloadController
 from std_msgs.msg import Bool
@@ -121,6 +122,7 @@ class Spawner:
                 rospy.loginfo(f"Started controllers: {', '.join(self.loaded)}")
             else:
                 rospy.logerr(f"Failed to start controllers: {', '.join(self.loaded)}")
+        _stop_following_sim_time()
         self.stop.wait()
         return 0
 
@@ -141,6 +143,16 @@ class Spawner:
                 rospy.loginfo(f"Succeeded in unloading {name}")
         except (rospy.ServiceException, rospy.ROSException) as error:
             rospy.logwarn(f"Controller Spawner error while taking down controllers: {error}")
+
+
+def _stop_following_sim_time():
+    """From here the spawner only waits for its end. Under /use_sim_time rospy takes in every /clock message
+    (thousands a wall second while the simulation runs fast), CPU the simulator needs on a small machine (5 ms
+    per sim second on two cores); rospy has no call to stop that, so its /clock subscriber is unregistered. The
+    spawner's log lines at shutdown then carry the last sim time it had."""
+    subscriber = getattr(rospy.impl.simtime, "_clock_sub", None)  # set only under /use_sim_time
+    if subscriber is not None:
+        subscriber.unregister()
 
 
 def main():
