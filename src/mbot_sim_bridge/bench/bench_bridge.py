@@ -14,6 +14,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from typing import Dict
 
@@ -130,7 +131,14 @@ def main():
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time the bridge is measured")
     parser.add_argument("--launches", type=int, default=7, help="launches timed to the first /odom")
     args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="mbot_bench_logs_") as logs:
+        # Every ROS process of the bench logs here, not into ~/.ros/log: roslaunch measures the size of its log
+        # directory (du) at each start, which grows with every run there and would count in the launch times.
+        os.environ["ROS_LOG_DIR"] = logs
+        run(args)
 
+
+def run(args):
     raw = raw_pybullet_rtf(args.sim_seconds)
     print(f"raw PyBullet real-time factor: {raw:.2f}", flush=True)
     with PrivateMaster() as master:
