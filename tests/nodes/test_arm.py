@@ -75,9 +75,9 @@ class Arm(unittest.TestCase):
     def positions(self, names=JOINTS):
         return [self.joint_positions[name] for name in names]
 
-    def follow(self, points, client=0, **goal_fields):
+    def follow(self, points, client=0, feedback_cb=None, **goal_fields):
         goal = FollowJointTrajectoryGoal(trajectory=trajectory(points), **goal_fields)
-        self.trajectory_clients[client].send_goal(goal)
+        self.trajectory_clients[client].send_goal(goal, feedback_cb=feedback_cb)
 
     def result(self, client=0):
         action = self.trajectory_clients[client]
@@ -96,9 +96,18 @@ class Arm(unittest.TestCase):
 
     def test_01_a_two_point_goal_succeeds_with_every_joint_at_its_goal(self):
         target = [0.8, 0.6, 0.9, -0.5, 0.4, 0.3]
-        self.follow([(1.0, [0.4, 0.3, 0.45, -0.25, 0.2, 0.15]), (2.0, target)])
+        feedback = []
+        self.follow([(1.0, [0.4, 0.3, 0.45, -0.25, 0.2, 0.15]), (2.0, target)], feedback_cb=feedback.append)
         state, result = self.result()
         self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, FollowJointTrajectoryResult.SUCCESSFUL))
+        # Feedback at the YAML's action_monitor_rate (10 Hz) while the 2 s goal ran, each stamped with its step.
+        stamps = [message.header.stamp.to_sec() for message in feedback]
+        self.assertGreaterEqual(len(stamps), 19, stamps)
+        self.assertTrue(all(abs(later - earlier - 0.1) < 1e-6 for earlier, later in zip(stamps, stamps[1:])), stamps)
+        self.assertEqual(list(feedback[-1].joint_names), JOINTS)
+        self.assertLess(max(abs(a - b) for a, b in zip(feedback[-1].desired.positions, target)), 0.1)
+        self.figures.append(f"arm goal feedback: {len(stamps)} messages over {stamps[-1] - stamps[0]:.3f} s of sim "
+                            "time, 0.1 s apart")
         self.settle()
         errors = [abs(a - b) for a, b in zip(self.positions(), target)]
         self.assertLess(max(errors), GOAL_TOLERANCE, errors)

@@ -12,6 +12,7 @@ import math
 
 import actionlib
 import rospy
+from actionlib_msgs.msg import GoalStatus
 from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectoryFeedback, FollowJointTrajectoryResult,
                               GripperCommandAction, GripperCommandResult, JointControllerState,
                               JointTrajectoryControllerState)
@@ -28,13 +29,16 @@ from ..core.ros_control.diff_drive_controller import CommandSample, DiffDriveCon
 from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.ros_control.joint_trajectory_controller import (ABORTED, SUCCEEDED, JointTolerance, JointTrajectory,
-                                                            JointTrajectoryController, TrajectoryGoal,
+                                                            JointTrajectoryController, StatePoints, TrajectoryGoal,
                                                             TrajectoryPoint)
 from ..core.ros_control.pid_controllers import StateSampling
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame
 from . import loop_publisher, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance
+
+# A goal's statuses while feedback for it means something.
+_GOING = (GoalStatus.ACTIVE, GoalStatus.PREEMPTING)
 
 
 class RosJointStateController(JointStateController):
@@ -221,30 +225,27 @@ class RosJointTrajectoryController(_ActionController, JointTrajectoryController)
             raise rospy.ServiceException("the trajectory cannot be sampled at that time (see the simulator's log)")
         return QueryTrajectoryStateResponse(list(self.joint_names), *sampled)
 
-    def _fill(self, message, stamp):
+    def _fill(self, message, stamp, points: StatePoints):
         """The header and the desired, actual and error points of a state or feedback message."""
         message.header.stamp = stamp
         message.joint_names = list(self.joint_names)
-        desired_from_start, actual_from_start, error_from_start = self.times_from_start
-        message.desired.positions, message.desired.velocities, message.desired.accelerations = self.desired
+        desired_from_start, actual_from_start, error_from_start = points.times_from_start
+        message.desired.positions, message.desired.velocities, message.desired.accelerations = points.desired
         message.desired.time_from_start = rospy.Duration.from_sec(desired_from_start)
-        message.actual.positions, message.actual.velocities = self.actual
+        message.actual.positions, message.actual.velocities = points.actual
         message.actual.time_from_start = rospy.Duration.from_sec(actual_from_start)
-        message.error.positions, message.error.velocities = self.error[:2]
+        message.error.positions, message.error.velocities = points.error[:2]
         message.error.time_from_start = rospy.Duration.from_sec(error_from_start)
         return message
 
     def publish(self, stamp):
+        for time, points in self.outbox:
+            if points.goal is None:
+                self.state_publisher.publish(self._fill(JointTrajectoryControllerState(), ros_time(time), points))
+            elif points.goal.handle.get_goal_status().status in _GOING:  # its result may have gone out since
+                points.goal.handle.publish_feedback(self._fill(FollowJointTrajectoryFeedback(), ros_time(time),
+                                                               points))
         self._send_ended()
-        with self.lock:
-            state = self._fill(JointTrajectoryControllerState(), stamp) if self.state_due else None
-            active = self.active_goal
-            feedback = self._fill(FollowJointTrajectoryFeedback(), stamp) if self.feedback_due and active else None
-            self.state_due = self.feedback_due = False
-        if state is not None:
-            self.state_publisher.publish(state)
-        if feedback is not None:
-            active.handle.publish_feedback(feedback)
 
     def close(self):
         super().close()

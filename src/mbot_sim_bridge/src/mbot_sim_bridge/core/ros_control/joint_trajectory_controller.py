@@ -8,20 +8,20 @@ smooth stop) on start, on cancel and on an empty trajectory; path and goal toler
 the goal; the goal's outcome with FollowJointTrajectory's error codes.
 
 The ROS layer (``plugins/ros_controllers.py``) owns the topics, the action server and the query_state service;
-it hands goals in as ``TrajectoryGoal`` and publishes what ``ended`` collects. Goal callbacks arrive in ROS
-threads, the update in the loop thread: ``lock`` serialises them.
+it hands goals in as ``TrajectoryGoal`` and publishes what ``ended`` collects, and the state and feedback
+that the update puts into the ``outbox`` at ``state_publish_rate`` and ``action_monitor_rate``. Goal callbacks
+arrive in ROS threads, the update in the loop thread: ``lock`` serialises them.
 """
 import copy
 import math
 import sys
 import threading
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence, Tuple
+from typing import List, NamedTuple, Optional, Sequence, Tuple
 
 from ..log import get_logger, warn_once
 from .angles import shortest_angular_distance
 from .control_toolbox import Pid
-from ..clock import steps_until_past
 from .controller_interface import Controller, param
 from .controller_manager import ControllerInitError
 from .hardware_interface import POSITION
@@ -105,6 +105,17 @@ class GoalEnd:
     status: str  # SUCCEEDED, ABORTED or CANCELED
     error_code: int = SUCCESSFUL
     error_string: str = ""
+
+
+class StatePoints(NamedTuple):
+    """What the ``state`` topic and the action's feedback carry, as one update left it: the desired
+    (positions, velocities, accelerations), actual (positions, velocities) and error points, their times from
+    the segment's start; ``goal`` is the goal a feedback is for (None: the state topic)."""
+    desired: Tuple[List[float], List[float], List[float]]
+    actual: Tuple[List[float], List[float]]
+    error: Tuple[List[float], List[float], List[float]]
+    times_from_start: Tuple[float, float, float]  # desired, actual, error
+    goal: Optional[TrajectoryGoal]
 
 
 def _spline_coefficients(start: Tuple[float, Optional[float], Optional[float]],
@@ -309,7 +320,6 @@ class JointTrajectoryController(Controller):
         self.ended: List[GoalEnd] = []
         self._last_state_publish = 0.0
         self._last_feedback = -math.inf
-        self.state_due = self.feedback_due = False
 
     def _tolerances_from_params(self, constraints: dict) -> List[JointTolerances]:
         """getSegmentTolerances: ``<joint>/trajectory`` and ``<joint>/goal`` positions, the shared
@@ -522,11 +532,15 @@ class JointTrajectoryController(Controller):
             self.adapter.command(period, self.desired, self.error)
             if self.state_publish_period > 0.0 and self._last_state_publish + self.state_publish_period < self.uptime:
                 self._last_state_publish += self.state_publish_period
-                self.state_due = True
+                self.outbox.append((now, self._points(None)))
             if (self.active_goal is not None and self.action_monitor_period > 0.0
                     and self.time - self._last_feedback >= self.action_monitor_period - 1e-9):
                 self._last_feedback = self.time
-                self.feedback_due = True
+                self.outbox.append((now, self._points(self.active_goal)))
+
+    def _points(self, goal: Optional[TrajectoryGoal]) -> StatePoints:
+        # _update_states makes new lists at every update, so these are not changed afterwards.
+        return StatePoints(self.desired, self.actual, self.error, self.times_from_start, goal)
 
     def _abort(self, error_code: int, error_string: str):
         self.ended.append(GoalEnd(self.active_goal, ABORTED, error_code, error_string))
@@ -578,19 +592,9 @@ class JointTrajectoryController(Controller):
             return [state[0] for state in states], [state[1] for state in states], [state[2] for state in states]
 
     def publish_due(self, now):
-        return self.state_due or self.feedback_due or bool(self.ended)
+        return bool(self.ended)
 
     def steps_until_publish(self, now, step_size):
-        # The state at state_publish_rate of controller uptime, the feedback at action_monitor_rate while a goal
-        # is active; a goal's end waits for the next stop, as upstream's waits for its action monitor timer.
-        with self.lock:
-            if self.publish_due(now):
-                return 1
-            steps = sys.maxsize
-            if self.state_publish_period > 0.0:
-                steps = steps_until_past(self._last_state_publish + self.state_publish_period, self.uptime,
-                                         step_size)
-            if self.active_goal is not None and self.action_monitor_period > 0.0:
-                steps = min(steps, steps_until_past(self._last_feedback + self.action_monitor_period - 1e-9,
-                                                    self.time, step_size))
-            return steps
+        # The state and the feedback go into the outbox at their step; a goal's end waits for the next stop, as
+        # upstream's waits for its action monitor timer.
+        return 1 if self.ended else sys.maxsize
