@@ -23,3 +23,14 @@ def shortest_angular_distance_with_limits(start: float, end: float, lower: float
         if lower <= start + candidate <= upper:
             return candidate
     return delta
+
+
+def position_error(joint_type: str, current: float, target: float, lower: float, upper: float) -> float:
+    """How far a joint of URDF ``joint_type`` is from ``target``, as ros_controllers' position controllers and
+    gazebo_ros_control's PID take it: within the limits for a revolute joint, the shortest way round for a
+    continuous one, the plain difference otherwise."""
+    if joint_type == "revolute":
+        return shortest_angular_distance_with_limits(current, target, lower, upper)
+    if joint_type == "continuous":
+        return shortest_angular_distance(current, target)
+    return target - current

@@ -6,20 +6,12 @@ upstream fills its control_msgs/JointControllerState (``state``) then; the ROS l
 from typing import NamedTuple, Optional
 
 from ..robot_model import RobotModel
-from .angles import shortest_angular_distance, shortest_angular_distance_with_limits
+from .angles import position_error
 from .control_toolbox import Pid
 from .controller_manager import ControllerInitError
 from .hardware_interface import EFFORT
 from .controller_interface import Controller, param
 from .forward_command_controller import ForwardJointGroupCommandController, joint_name_param
-
-
-def _position_error(joint_type: str, current: float, target: float, lower: float, upper: float) -> float:
-    if joint_type == "revolute":
-        return shortest_angular_distance_with_limits(current, target, lower, upper)
-    if joint_type == "continuous":
-        return shortest_angular_distance(current, target)
-    return target - current
 
 
 class _UrdfJointLimits:
@@ -106,7 +98,7 @@ class PidPositionController(StateSampling, Controller):
 
     def update(self, now, period):
         target = self.urdf.enforce(self.target)
-        self.error = _position_error(self.urdf.type, self.joint.position, target, self.urdf.lower, self.urdf.upper)
+        self.error = position_error(self.urdf.type, self.joint.position, target, self.urdf.lower, self.urdf.upper)
         velocity_error = None if self.target_velocity is None else self.target_velocity - self.joint.velocity
         self.output = self.pid.compute(self.error, period, velocity_error)
         self.joint.command = self.output
@@ -165,5 +157,5 @@ class EffortGroupPositionController(ForwardJointGroupCommandController):
     def update(self, now, period):
         for joint, command, limits, pid in zip(self.joints, self.commands, self.urdf, self.pids):
             target = limits.enforce(command)
-            joint.command = pid.compute(_position_error(limits.type, joint.position, target, limits.lower,
+            joint.command = pid.compute(position_error(limits.type, joint.position, target, limits.lower,
                                                         limits.upper), period)

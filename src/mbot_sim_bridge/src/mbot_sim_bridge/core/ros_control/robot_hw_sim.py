@@ -13,7 +13,7 @@ from typing import Dict, List, Optional, Sequence
 from ..errors import ConfigError
 from ..log import get_logger, info_once, warn_once
 from ..robot_model import RobotModel
-from .angles import normalize_angle, shortest_angular_distance, shortest_angular_distance_with_limits
+from .angles import normalize_angle, position_error
 from .control_toolbox import Pid, clamp
 from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,
                                  UNBOUNDED_EFFORT, VELOCITY, HardwareInterfaceError)
@@ -300,12 +300,7 @@ class DefaultRobotHWSim:
         """The effort a PID-driven position or velocity joint gets (on e-stop: towards the held position or zero
         speed), within the joint's effort limit."""
         if joint.interface == POSITION:
-            if joint.joint_type == "revolute":
-                error = shortest_angular_distance_with_limits(joint.position, joint.command, joint.lower, joint.upper)
-            elif joint.joint_type == "continuous":
-                error = shortest_angular_distance(joint.position, joint.command)
-            else:
-                error = joint.command - joint.position
+            error = position_error(joint.joint_type, joint.position, joint.command, joint.lower, joint.upper)
         else:
             error = -joint.velocity if self.e_stop_active else joint.command - joint.velocity
         limit = joint.effort_limit
