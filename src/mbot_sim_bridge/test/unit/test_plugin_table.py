@@ -1,13 +1,20 @@
-"""The one plugin table: the ROS registry derived from it, no copy of it elsewhere, added plugin blocks checked."""
+"""The one plugin table: the ROS registry derived from it, both loaded per file name, no copy of the table
+elsewhere, added plugin blocks checked."""
+import importlib
 import os
+import pkgutil
 import re
 import subprocess
+import sys
 
 import pytest
 
 from mbot_sim_bridge.core.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.plugin import Plugin
-from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS, filename_of
+from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS, LazyClassTable, filename_of
+from mbot_sim_bridge.core.mimic_joint import MimicJoint
+from mbot_sim_bridge.core.range_sensor import HectorSonar
+from mbot_sim_bridge.plugins import registry
 from mbot_sim_bridge.plugins.registry import REGISTRY
 
 WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
@@ -32,8 +39,60 @@ def test_no_copy_of_the_table_outside_its_module():
     assert not copies, copies
 
 
+def test_every_plugin_class_of_the_ros_package_is_reachable_through_the_registry():
+    """A class in a module the registry never looks in would be dead: each one is some file name's class."""
+    package = importlib.import_module("mbot_sim_bridge.plugins")
+    registered = set(REGISTRY.values())
+    for module_info in pkgutil.iter_modules(package.__path__):
+        module = importlib.import_module(f"{package.__name__}.{module_info.name}")
+        for plugin_class in registry.plugin_classes(module):
+            in_use = plugin_class in registered or any(issubclass(ros_class, plugin_class) for ros_class in registered)
+            assert in_use, f"{module.__name__}.{plugin_class.__name__}"
+
+
+def test_a_second_file_name_shares_the_first_ones_ros_module():
+    assert registry.home_module("libgazebo_ros_gpu_laser.so") == "mbot_sim_bridge.plugins.gazebo_ros_laser"
+    assert REGISTRY["libgazebo_ros_gpu_laser.so"] is REGISTRY["libgazebo_ros_laser.so"]
+    assert REGISTRY["libroboticsgroup_gazebo_mimic_joint_plugin.so"].__module__ == \
+        "mbot_sim_bridge.plugins.roboticsgroup_upatras_gazebo_mimic_joint_plugin"
+
+
+# Run in a fresh interpreter: this one has imported every plugin already.
+IMPORTED_PLUGIN_MODULES = """
+import sys
+import mbot_sim_bridge.node
+from mbot_sim_bridge.plugins.registry import REGISTRY
+REGISTRY.get("libgazebo_ros_diff_drive.so")
+print(" ".join(sorted(name for name in sys.modules if name.startswith("mbot_sim_bridge."))))
+"""
+
+
+def test_the_node_imports_only_the_plugins_it_looks_up():
+    imported = set(subprocess.run([sys.executable, "-c", IMPORTED_PLUGIN_MODULES], capture_output=True, text=True,
+                                  check=True).stdout.split())
+    assert {"mbot_sim_bridge.core.diff_drive", "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"} <= imported
+    # The simulation itself uses the joint state publisher (joints no plugin publishes) and the mimic joint.
+    used = {f"mbot_sim_bridge.core.{module}" for module in ("diff_drive", "joint_states", "mimic_joint")}
+    assert not ({core_class.__module__ for core_class in CORE_PLUGINS.values()} - used) & imported
+    assert not {module for module in imported if module.startswith("mbot_sim_bridge.plugins.gazebo_ros_")} - {
+        "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"}
+    assert "mbot_sim_bridge.core.ros_control.controller_table" not in imported
+
+
+def test_a_lazy_table_loads_each_key_once_and_refuses_unknown_ones():
+    loads = []
+    table = LazyClassTable(["a", "b"], lambda key: loads.append(key) or type(key.upper(), (), {}))
+    assert list(table) == ["a", "b"] and len(table) == 2 and loads == []
+    assert table["b"] is table["b"] and loads == ["b"]
+    assert table.get("c") is None and "c" not in table
+    with pytest.raises(KeyError):
+        table["c"]
+
+
 def test_the_file_name_of_a_class():
     assert filename_of(JointStatePublisher) == "libgazebo_ros_joint_state_publisher.so"
+    assert filename_of(MimicJoint) == "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so"
+    assert filename_of(HectorSonar) == "libhector_gazebo_ros_sonar.so"
 
 
 def test_a_plugin_block_the_simulator_adds_uses_only_known_tags():

@@ -22,7 +22,7 @@ from .parameters import absolute_name
 from .params import Param
 from .plugin import Plugin
 from .robot_model import RobotModel, parse_robot
-from .ros_control import CORE_CONTROLLERS
+from .ros_control.controller_table import CORE_CONTROLLERS
 from .ros_control.controller_manager import ControllerManager
 from .ros_control.robot_hw_sim import ROBOT_HW_SIMS
 from .ros_control.transmissions import parse_transmissions

@@ -21,8 +21,6 @@ from .plugin import Plugin
 from .ros_control.control_toolbox import Pid, clamp
 from .ros_control.hardware_interface import UNBOUNDED_EFFORT
 
-MIMIC_PLUGIN = "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so"
-
 
 class MimicJoint(Plugin):
     """Core of roboticsgroup's MimicJointPlugin."""

@@ -2,64 +2,79 @@
 
 This is the one plugin table. The ROS node's registry (``plugins/registry.py``) is derived from it, and the demo,
 the benchmarks and the tests build their Simulations from it; adding a plugin adds one line here.
+
+A line names its class as ``module.Class`` of this package, imported when a model first uses the file name, as
+Gazebo loads a plugin's library only when a model names it: a launch imports the plugins its models use, not all
+of them (importing every plugin, with its ROS side, took 30 ms of the simulator's start-up).
 """
-from typing import Dict
+import importlib
+from typing import Callable, Dict, Iterable, Iterator, Mapping
 
-from .block_laser import BlockLaser
-from .bumper import Bumper
-from .camera import Camera, DepthCamera, PlainDepthCamera
-from .diff_drive import DiffDrive
-from .f3d import F3D
-from .ft_sensor import FTSensor
-from .gazebo_ros_control import GazeboRosControlPlugin
-from .hector_gps import HectorGps
-from .hector_imu import HectorImu
-from .hector_magnetic import HectorMagnetic
-from .imu import ImuModelPlugin, ImuSensor
-from .joint_states import JointStatePublisher
-from .lidar import RaySensor
-from .mimic_joint import MIMIC_PLUGIN, MimicJoint
-from .multicamera import MultiCamera
-from .p3d import P3D
-from .planar_move import PlanarMove
-from .range_sensor import HectorSonar, RangeSensor
-from .skid_steer_drive import SkidSteerDrive
-from .tricycle_drive import TricycleDrive
-from .velodyne_laser import VelodyneLaser
-
-CORE_PLUGINS: Dict[str, type] = {
-    "libgazebo_ros_control.so": GazeboRosControlPlugin,
-    "libgazebo_ros_diff_drive.so": DiffDrive,
-    "libgazebo_ros_joint_state_publisher.so": JointStatePublisher,
-    "libgazebo_ros_laser.so": RaySensor,
-    "libgazebo_ros_gpu_laser.so": RaySensor,
-    "libgazebo_ros_camera.so": Camera,
-    "libgazebo_ros_multicamera.so": MultiCamera,
-    "libgazebo_ros_openni_kinect.so": DepthCamera,
-    "libgazebo_ros_depth_camera.so": PlainDepthCamera,
-    "libgazebo_ros_imu.so": ImuModelPlugin,
-    "libgazebo_ros_imu_sensor.so": ImuSensor,
-    "libgazebo_ros_p3d.so": P3D,
-    "libgazebo_ros_f3d.so": F3D,
-    "libgazebo_ros_ft_sensor.so": FTSensor,
-    "libgazebo_ros_planar_move.so": PlanarMove,
-    "libgazebo_ros_skid_steer_drive.so": SkidSteerDrive,
-    "libgazebo_ros_tricycle_drive.so": TricycleDrive,
-    "libhector_gazebo_ros_imu.so": HectorImu,
-    "libhector_gazebo_ros_gps.so": HectorGps,
-    "libhector_gazebo_ros_magnetic.so": HectorMagnetic,
-    "libgazebo_ros_range.so": RangeSensor,
-    "libgazebo_ros_bumper.so": Bumper,
-    "libhector_gazebo_ros_sonar.so": HectorSonar,
-    "libgazebo_ros_velodyne_laser.so": VelodyneLaser,
-    "libgazebo_ros_velodyne_gpu_laser.so": VelodyneLaser,
-    "libgazebo_ros_block_laser.so": BlockLaser,
-    MIMIC_PLUGIN: MimicJoint,
+_REFERENCES: Dict[str, str] = {
+    "libgazebo_ros_control.so": "gazebo_ros_control.GazeboRosControlPlugin",
+    "libgazebo_ros_diff_drive.so": "diff_drive.DiffDrive",
+    "libgazebo_ros_joint_state_publisher.so": "joint_states.JointStatePublisher",
+    "libgazebo_ros_laser.so": "lidar.RaySensor",
+    "libgazebo_ros_gpu_laser.so": "lidar.RaySensor",
+    "libgazebo_ros_camera.so": "camera.Camera",
+    "libgazebo_ros_multicamera.so": "multicamera.MultiCamera",
+    "libgazebo_ros_openni_kinect.so": "camera.DepthCamera",
+    "libgazebo_ros_depth_camera.so": "camera.PlainDepthCamera",
+    "libgazebo_ros_imu.so": "imu.ImuModelPlugin",
+    "libgazebo_ros_imu_sensor.so": "imu.ImuSensor",
+    "libgazebo_ros_p3d.so": "p3d.P3D",
+    "libgazebo_ros_f3d.so": "f3d.F3D",
+    "libgazebo_ros_ft_sensor.so": "ft_sensor.FTSensor",
+    "libgazebo_ros_planar_move.so": "planar_move.PlanarMove",
+    "libgazebo_ros_skid_steer_drive.so": "skid_steer_drive.SkidSteerDrive",
+    "libgazebo_ros_tricycle_drive.so": "tricycle_drive.TricycleDrive",
+    "libhector_gazebo_ros_imu.so": "hector_imu.HectorImu",
+    "libhector_gazebo_ros_gps.so": "hector_gps.HectorGps",
+    "libhector_gazebo_ros_magnetic.so": "hector_magnetic.HectorMagnetic",
+    "libgazebo_ros_range.so": "range_sensor.RangeSensor",
+    "libgazebo_ros_bumper.so": "bumper.Bumper",
+    "libhector_gazebo_ros_sonar.so": "range_sensor.HectorSonar",
+    "libgazebo_ros_velodyne_laser.so": "velodyne_laser.VelodyneLaser",
+    "libgazebo_ros_velodyne_gpu_laser.so": "velodyne_laser.VelodyneLaser",
+    "libgazebo_ros_block_laser.so": "block_laser.BlockLaser",
+    "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": "mimic_joint.MimicJoint",
     # The same plugin under the package's name before 2020.
-    "libroboticsgroup_gazebo_mimic_joint_plugin.so": MimicJoint,
+    "libroboticsgroup_gazebo_mimic_joint_plugin.so": "mimic_joint.MimicJoint",
 }
 
 
+class LazyClassTable(Mapping):
+    """Key -> class, each made by ``load(key)`` at its first lookup and kept; an unknown key is a KeyError."""
+
+    def __init__(self, keys: Iterable[str], load: Callable[[str], type]):
+        self._keys = dict.fromkeys(keys)  # ordered, for iteration and membership
+        self._load = load
+        self._classes: Dict[str, type] = {}
+
+    def __getitem__(self, key: str) -> type:
+        loaded = self._classes.get(key)
+        if loaded is None:
+            if key not in self._keys:
+                raise KeyError(key)
+            loaded = self._classes[key] = self._load(key)
+        return loaded
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._keys)
+
+    def __len__(self) -> int:
+        return len(self._keys)
+
+
+def _import(filename: str) -> type:
+    module, name = _REFERENCES[filename].rsplit(".", 1)
+    return getattr(importlib.import_module(f"{__package__}.{module}"), name)
+
+
+CORE_PLUGINS: Mapping[str, type] = LazyClassTable(_REFERENCES, _import)
+
+
 def filename_of(plugin_class: type) -> str:
-    """The (first) file name under which the core class ``plugin_class`` is in the table."""
-    return next(filename for filename, core_class in CORE_PLUGINS.items() if core_class is plugin_class)
+    """The (first) file name under which the core class ``plugin_class`` is in the table; imports no other."""
+    reference = f"{plugin_class.__module__.rpartition('.')[2]}.{plugin_class.__name__}"
+    return next(filename for filename, entry in _REFERENCES.items() if entry == reference)

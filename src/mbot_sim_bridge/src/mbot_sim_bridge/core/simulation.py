@@ -21,7 +21,7 @@ from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
 from .joint_states import JointStatePublisher
 from .log import get_logger, warn_once
-from .mimic_joint import MIMIC_PLUGIN, MimicJoint
+from .mimic_joint import MimicJoint
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext
 from .plugin_table import filename_of
@@ -35,6 +35,8 @@ _logger = get_logger(__name__)
 
 # The bridge publishes the joint states no plugin publishes through this plugin, as a Gazebo user would add it.
 JOINT_STATE_PLUGIN = filename_of(JointStatePublisher)
+# And a URDF <mimic> joint through roboticsgroup's mimic joint plugin.
+MIMIC_PLUGIN = filename_of(MimicJoint)
 # Above this many links a spawn takes seconds (PyBullet's URDF import): said first, so a pause is explained.
 LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.

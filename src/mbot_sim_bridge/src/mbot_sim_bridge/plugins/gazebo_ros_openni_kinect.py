@@ -1,10 +1,9 @@
-"""``libgazebo_ros_openni_kinect.so`` and ``libgazebo_ros_depth_camera.so``: rgb image, depth image, point
-cloud and the two camera_info topics of a depth sensor, from one render per sensor frame, only while
-something is subscribed."""
+"""``libgazebo_ros_openni_kinect.so``: rgb image, depth image, point cloud and the two camera_info topics of a
+depth sensor, from one render per sensor frame, only while something is subscribed."""
 import rospy
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
-from ..core.camera import DepthCamera, PlainDepthCamera
+from ..core.camera import DepthCamera
 from ..core.image_formats import POINT_FIELDS, POINT_STEP
 from ..core.names import resolve_frame
 from . import RosPlugin, ros_time
@@ -43,9 +42,6 @@ class GazeboRosOpenniKinect(RosPlugin, DepthCamera):
                       f"{self.cloud_publisher.resolved_name} (frame '{self.frame_id}'), {config.width}x{config.height} "
                       f"at {self.frame_rate:g} Hz, camera_info at {info_rate}, cloud within ({self.cutoff:g}, "
                       f"{self.cutoff_max:g}) m ({self.renderer.renderer} renderer)")
-        if isinstance(self, PlainDepthCamera):
-            rospy.loginfo(f"{self.label}: the reflectance and normals topics of "
-                          "libgazebo_ros_depth_camera.so are not published")
 
     def update(self, now: float):
         image_wanted, depth_wanted, cloud_wanted = (self.topics.listened(publisher) for publisher in (
@@ -74,7 +70,3 @@ class GazeboRosOpenniKinect(RosPlugin, DepthCamera):
             self.info.header.stamp = stamp
             for publisher in info_wanted:
                 publisher.publish(self.info)
-
-
-class GazeboRosDepthCamera(GazeboRosOpenniKinect, PlainDepthCamera):
-    """The same outputs without pointCloudCutoffMax."""

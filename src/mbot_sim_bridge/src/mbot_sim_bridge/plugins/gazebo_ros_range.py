@@ -1,15 +1,15 @@
-"""``libgazebo_ros_range.so`` and ``libhector_gazebo_ros_sonar.so``: a ray sensor's nearest reading as
-sensor_msgs/Range."""
+"""``libgazebo_ros_range.so``: a ray sensor's nearest reading as sensor_msgs/Range."""
 import rospy
 from sensor_msgs.msg import Range
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.range_sensor import HectorSonar, RangeSensor
+from ..core.range_sensor import RangeSensor
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 
-class _RangePublisher(RosPlugin):
-    """The Range topic of either plugin: the message made once and refilled, published only while subscribed."""
+class RangePublisher(RosPlugin):
+    """The Range topic of this plugin and of hector's sonar (hector_gazebo_ros_sonar.py): the message made once
+    and refilled, published only while subscribed."""
 
     def advertise(self, topic: str, frame_id: str):
         config = self.config
@@ -29,14 +29,8 @@ class _RangePublisher(RosPlugin):
         self.publisher.publish(self.message)
 
 
-class GazeboRosRange(_RangePublisher, RangeSensor):
+class GazeboRosRange(RangePublisher, RangeSensor):
     def __init__(self, context, element, sensor):
         super().__init__(context, element, sensor)
         prefix = tf_prefix(context.simulation.parameters, self.robot_namespace())
         self.advertise(self.params["topicName"], resolve_frame(self.params["frameName"], prefix))
-
-
-class HectorGazeboRosSonar(_RangePublisher, HectorSonar):
-    def __init__(self, context, element, sensor):
-        super().__init__(context, element, sensor)
-        self.advertise(self.params["topicName"], self.params["frameId"])

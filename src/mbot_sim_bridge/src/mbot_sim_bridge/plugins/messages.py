@@ -1,13 +1,17 @@
 """The ROS messages the plugins publish, filled from the core's values: one place for the field layouts."""
+from __future__ import annotations
+
 import functools
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 from sensor_msgs.msg import CameraInfo, Image, Imu
 
-from ..core.camera import Intrinsics
-from ..core.imu import ImuReading, ImuReadings
 from . import ros_time
+
+if TYPE_CHECKING:  # the drives use this module too, and need not import the camera's and IMU's modules
+    from ..core.camera import Intrinsics
+    from ..core.imu import ImuReading, ImuReadings
 
 
 def set_xyz(field, values: Sequence[float]):

@@ -24,7 +24,7 @@ from std_msgs.msg import Float64, Float64MultiArray
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
-from ..core.ros_control import CORE_CONTROLLERS
+from ..core.ros_control.controller_table import CORE_CONTROLLERS
 from ..core.ros_control.diff_drive_controller import CommandSample, DiffDriveController, OdometrySample
 from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
