@@ -28,7 +28,7 @@ from . import loop_publishing
 from .plugins import loop_publisher, ros_time
 from .publisher_check import check_joint_state_publishers
 from .package_uris import resolve_package_uris
-from .processes import init_node, stop_on_signals
+from .processes import end_start_up, init_node, stop_on_signals
 from .plugins.registry import REGISTRY
 from .ros_parameters import RosParameters
 from .services import GazeboRosApi
@@ -230,6 +230,7 @@ def main():
         rospy.logfatal(str(error))
         rospy.signal_shutdown("bad input")
         sys.exit(1)
+    end_start_up()
     try:
         node.run(stop)
     except loop_publishing.WriterStopped as error:

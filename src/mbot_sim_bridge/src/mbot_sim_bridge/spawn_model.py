@@ -15,7 +15,7 @@ from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
 from .core.geometry import pose_from_xyz_rpy
-from .processes import init_node
+from .processes import end_start_up, init_node
 
 SERVICE_POLL_SECONDS = 0.02
 
@@ -157,6 +157,7 @@ def spawn(arguments):
 def main():
     arguments = parse_arguments(rospy.myargv(sys.argv)[1:])
     init_node("spawn_model", anonymous=True)
+    end_start_up()
     try:
         spawn(arguments)
     except (SpawnError, rospy.ServiceException) as error:
