@@ -57,6 +57,13 @@ def test_a_second_file_name_shares_the_first_ones_ros_module():
         "mbot_sim_bridge.plugins.roboticsgroup_upatras_gazebo_mimic_joint_plugin"
 
 
+def test_a_missing_ros_module_is_named(monkeypatch):
+    monkeypatch.setattr(registry, "home_module", lambda filename: "mbot_sim_bridge.plugins.gazebo_ros_no_such_drive")
+    with pytest.raises(ImportError, match="libgazebo_ros_diff_drive.so: the ROS side of DiffDrive belongs in "
+                                          "mbot_sim_bridge.plugins.gazebo_ros_no_such_drive, which is missing"):
+        registry.find_ros_class("libgazebo_ros_diff_drive.so")
+
+
 # Run in a fresh interpreter: this one has imported every plugin already.
 IMPORTED_PLUGIN_MODULES = """
 import sys

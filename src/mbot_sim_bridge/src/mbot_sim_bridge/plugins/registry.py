@@ -17,7 +17,7 @@ _PACKAGE = __name__.rsplit(".", 1)[0]
 _CORE_PACKAGE = Plugin.__module__.rsplit(".", 1)[0]
 
 
-def nearest_core_class(ros_class: type) -> type:
+def _nearest_core_class(ros_class: type) -> type:
     return next(base for base in ros_class.__mro__[1:] if base.__module__.startswith(_CORE_PACKAGE + "."))
 
 
@@ -33,7 +33,8 @@ def plugin_classes(module) -> list:
             if isinstance(value, type) and issubclass(value, Plugin) and value.__module__ == module.__name__]
 
 
-def _ros_class(filename: str) -> type:
+def find_ros_class(filename: str) -> type:
+    """``filename``'s ROS class, from its home module (REGISTRY keeps what this finds)."""
     core_class = CORE_PLUGINS[filename]
     module_name = home_module(filename)
     try:
@@ -43,7 +44,7 @@ def _ros_class(filename: str) -> type:
             raise
         raise ImportError(f"{filename}: the ROS side of {core_class.__name__} belongs in {module_name}, which is "
                           "missing") from None
-    candidates = [ros_class for ros_class in plugin_classes(module) if nearest_core_class(ros_class) is core_class]
+    candidates = [ros_class for ros_class in plugin_classes(module) if _nearest_core_class(ros_class) is core_class]
     if len(candidates) != 1:
         found = ", ".join(candidate.__name__ for candidate in candidates) or "none"
         raise ImportError(f"{filename}: {module_name} must have one class extending {core_class.__name__} first; "
@@ -51,4 +52,4 @@ def _ros_class(filename: str) -> type:
     return candidates[0]
 
 
-REGISTRY: Mapping[str, type] = LazyClassTable(CORE_PLUGINS, _ros_class)
+REGISTRY: Mapping[str, type] = LazyClassTable(CORE_PLUGINS, find_ros_class)
