@@ -17,24 +17,18 @@ from .pid_controllers import EffortGroupPositionController, EffortVelocityContro
 CORE_CONTROLLERS: Dict[str, type] = {
     "joint_state_controller/JointStateController": JointStateController,
     "diff_drive_controller/DiffDriveController": DiffDriveController,
-    "position_controllers/JointPositionController":
-        forward_type(ForwardCommandController, POSITION, True, "PositionJointPositionController"),
-    "position_controllers/JointGroupPositionController":
-        forward_type(ForwardJointGroupCommandController, POSITION, True, "PositionJointGroupPositionController"),
-    "velocity_controllers/JointVelocityController":
-        forward_type(ForwardCommandController, VELOCITY, False, "VelocityJointVelocityController"),
-    "velocity_controllers/JointGroupVelocityController":
-        forward_type(ForwardJointGroupCommandController, VELOCITY, False, "VelocityJointGroupVelocityController"),
     "velocity_controllers/JointPositionController":
         type("VelocityJointPositionController", (PidPositionController,), {"INTERFACE": VELOCITY}),
-    "effort_controllers/JointEffortController":
-        forward_type(ForwardCommandController, EFFORT, False, "EffortJointEffortController"),
-    "effort_controllers/JointGroupEffortController":
-        forward_type(ForwardJointGroupCommandController, EFFORT, False, "EffortJointGroupEffortController"),
     "effort_controllers/JointPositionController":
         type("EffortJointPositionController", (PidPositionController,), {"INTERFACE": EFFORT}),
     "effort_controllers/JointVelocityController": EffortVelocityController,
     "effort_controllers/JointGroupPositionController": EffortGroupPositionController,
+    # position_/velocity_/effort_controllers' forward ones, single joint and group; position starts where it is.
+    **{f"{kind}_controllers/Joint{group}{kind.capitalize()}Controller":
+       forward_type(base, interface, interface == POSITION,
+                    f"{kind.capitalize()}Joint{group}{kind.capitalize()}Controller")
+       for kind, interface in (("position", POSITION), ("velocity", VELOCITY), ("effort", EFFORT))
+       for group, base in (("", ForwardCommandController), ("Group", ForwardJointGroupCommandController))},
     **{f"{kind}_controllers/JointTrajectoryController":
        type(f"{kind.capitalize()}JointTrajectoryController", (JointTrajectoryController,), {"INTERFACE": interface})
        for kind, interface in (("position", POSITION), ("velocity", VELOCITY), ("effort", EFFORT))},
