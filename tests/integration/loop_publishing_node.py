@@ -9,7 +9,7 @@ import time
 import numpy as np
 import rospy
 from mbot_sim_bridge import loop_publishing
-from mbot_sim_bridge.core.imu import ImuReading, ImuReadings
+from mbot_sim_bridge.core.sensors.imu import ImuReading, ImuReadings
 from mbot_sim_bridge.plugins.messages import imu_message, imu_records
 from geometry_msgs.msg import PointStamped
 from sensor_msgs.msg import Imu

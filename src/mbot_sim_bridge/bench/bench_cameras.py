@@ -26,13 +26,13 @@ sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
 
 from sensor_msgs.msg import Image  # noqa: E402 (after the path set-up)
 
-from mbot_sim_bridge.core.camera import Camera, DepthCamera  # noqa: E402
-from mbot_sim_bridge.core.diff_drive import DiffDrive  # noqa: E402
-from mbot_sim_bridge.core.imu import ImuModelPlugin  # noqa: E402
+from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera  # noqa: E402
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive  # noqa: E402
+from mbot_sim_bridge.core.sensors.imu import ImuModelPlugin  # noqa: E402
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS  # noqa: E402
-from mbot_sim_bridge.core.render_scene import RENDERER_ENV  # noqa: E402
-from mbot_sim_bridge.core.robot_model import parse_robot  # noqa: E402
-from mbot_sim_bridge.core.sdf_world import parse_world  # noqa: E402
+from mbot_sim_bridge.core.cameras.render_scene import RENDERER_ENV  # noqa: E402
+from mbot_sim_bridge.core.description.robot_model import parse_robot  # noqa: E402
+from mbot_sim_bridge.core.description.sdf_world import parse_world  # noqa: E402
 from mbot_sim_bridge.core.simulation import Simulation  # noqa: E402
 from mbot_sim_bridge.plugins.messages import imu_records  # noqa: E402
 

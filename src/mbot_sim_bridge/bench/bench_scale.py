@@ -26,11 +26,11 @@ BOXES = 5000
 
 def raw_robots_rtf(robots: int, sim_seconds: float) -> float:
     import xacro_noetic as xacro
-    from mbot_sim_bridge.core.diff_drive import DiffDrive
+    from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
     from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-    from mbot_sim_bridge.core.robot_model import parse_robot
-    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.description.robot_model import parse_robot
+    from mbot_sim_bridge.core.description.sdf_world import parse_world
     from mbot_sim_bridge.core.simulation import Simulation
 
     urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
@@ -67,7 +67,7 @@ def box_world(path: str):
 
 def raw_boxes_rtf(world_path: str, sim_seconds: float) -> float:
     from mbot_sim_bridge.core.engine import Engine
-    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.description.sdf_world import parse_world
     from mbot_sim_bridge.core.world_bodies import load_world
 
     engine = Engine()

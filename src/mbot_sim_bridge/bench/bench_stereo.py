@@ -16,10 +16,10 @@ import time
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
 from sensor_msgs.msg import Image
 
-from mbot_sim_bridge.core.multicamera import MultiCamera
+from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 

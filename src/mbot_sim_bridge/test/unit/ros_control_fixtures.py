@@ -6,12 +6,12 @@ import threading
 
 import yaml
 
-from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
+from mbot_sim_bridge.core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))

@@ -5,7 +5,7 @@ import os
 
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 _WORLD = """<?xml version="1.0"?>

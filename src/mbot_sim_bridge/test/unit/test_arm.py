@@ -8,7 +8,7 @@ import xacro_noetic as xacro
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, run_until_ended, simulate, start_controllers
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
     ABORTED, SUCCEEDED, SUCCESSFUL, JointTrajectory, TrajectoryGoal, TrajectoryPoint)
 from mbot_sim_bridge.package_uris import resolve_package_uris

@@ -1,11 +1,11 @@
-"""libgazebo_ros_bumper.so (core/bumper.py): a bumper reports the box it touches by Gazebo's name, with the normal
-pointing back at the robot, and nothing when clear; a collision name the link lacks is said once."""
+"""libgazebo_ros_bumper.so (core/sensors/bumper.py): a bumper reports the box it touches by Gazebo's name, with the
+normal pointing back at the robot, and nothing when clear; a collision name the link lacks is said once."""
 import pytest
 from sensor_fixtures import box, plugin_of, world_simulation
 
-from mbot_sim_bridge.core.bumper import Bumper
+from mbot_sim_bridge.core.sensors.bumper import Bumper
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 # A base with a bumper plate on a fixed joint: lumped into base_link, its collision keeps sdformat's lump name.
 ROBOT = """<robot name="bumper_bot">

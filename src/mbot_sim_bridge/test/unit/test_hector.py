@@ -1,4 +1,4 @@
-"""hector_gazebo_plugins' IMU, GPS and magnetometer (core/hector_imu.py, hector_gps.py, hector_magnetic.py):
+"""hector_gazebo_plugins' IMU, GPS and magnetometer (core/hector/hector_imu.py, hector_gps.py, hector_magnetic.py):
 gravity up at rest, the turn rate, the fix moving north or east by the distance travelled as upstream converts
 it, the field turning with the body, the sensor model."""
 import math
@@ -9,11 +9,11 @@ from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy
-from mbot_sim_bridge.core.hector_gps import HectorGps, earth_radii
-from mbot_sim_bridge.core.hector_imu import HectorImu
-from mbot_sim_bridge.core.hector_magnetic import HectorMagnetic
-from mbot_sim_bridge.core.hector_sensor_model import SensorModel
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.hector.hector_gps import HectorGps, earth_radii
+from mbot_sim_bridge.core.hector.hector_imu import HectorImu
+from mbot_sim_bridge.core.hector.hector_magnetic import HectorMagnetic
+from mbot_sim_bridge.core.hector.hector_sensor_model import SensorModel
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 BOX = """<robot name="box">
   <link name="base_link">

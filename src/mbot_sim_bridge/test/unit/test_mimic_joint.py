@@ -1,14 +1,14 @@
-"""Mimic joints (core/mimic_joint.py): a gripper finger with a URDF <mimic> follows its leader within 1 mm while the
-leader moves at a gripper's pace, and so does one set up with roboticsgroup's plugin (position or PID effort);
+"""Mimic joints (core/joints/mimic_joint.py): a gripper finger with a URDF <mimic> follows its leader within 1 mm while
+the leader moves at a gripper's pace, and so does one set up with roboticsgroup's plugin (position or PID effort);
 bad mimics are refused with the joint named."""
 import numpy as np
 import pytest
 from sensor_fixtures import world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError, ModelError
-from mbot_sim_bridge.core.mimic_joint import MimicJoint
+from mbot_sim_bridge.core.joints.mimic_joint import MimicJoint
 from mbot_sim_bridge.core.parameters import Parameters
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 GRIPPER = """<robot name="gripper">
   <link name="palm">

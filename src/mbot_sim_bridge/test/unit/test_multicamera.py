@@ -1,5 +1,5 @@
-"""libgazebo_ros_multicamera.so (core/multicamera.py) on mobile_test_robots' stereo head: a world point's disparity
-between the rendered left and right images is fx·baseline/depth within 1 px; the right camera's P carries
+"""libgazebo_ros_multicamera.so (core/cameras/multicamera.py) on mobile_test_robots' stereo head: a world point's
+disparity between the rendered left and right images is fx·baseline/depth within 1 px; the right camera's P carries
 Tx = −fx·hackBaseline and the left's 0; a camera named neither left nor right is said once; no usable camera is
 refused."""
 import math
@@ -12,8 +12,8 @@ from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.multicamera import MultiCamera
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 HEAD = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
                     "stereo_head.urdf.xacro")

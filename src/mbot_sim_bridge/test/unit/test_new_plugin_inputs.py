@@ -22,7 +22,7 @@ from test_velodyne import ROBOTS, STAND
 
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 VLP16_MACRO = os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro"))
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)

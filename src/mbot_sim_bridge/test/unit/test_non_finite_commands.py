@@ -7,7 +7,7 @@ import os
 import pytest
 
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control.controller_table import CORE_CONTROLLERS
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperActionController, GripperGoal

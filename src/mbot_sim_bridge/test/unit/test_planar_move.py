@@ -1,4 +1,4 @@
-"""libgazebo_ros_planar_move.so (core/planar_move.py) on mobile_test_robots' holonomic base: the base moves at
+"""libgazebo_ros_planar_move.so (core/drives/planar_move.py) on mobile_test_robots' holonomic base: the base moves at
 the commanded x, y and yaw rate within 1 %, odometry as upstream forms it, cmdTimeout, reset."""
 import math
 import os
@@ -8,8 +8,8 @@ import xacro_noetic as xacro
 from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose, yaw
-from mbot_sim_bridge.core.planar_move import PlanarMove
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.drives.planar_move import PlanarMove
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 BASE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
                     "holonomic_base.urdf.xacro")

@@ -9,11 +9,11 @@ import sys
 
 import pytest
 
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.joints.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.plugin import Plugin
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS, LazyClassTable, filename_of
-from mbot_sim_bridge.core.mimic_joint import MimicJoint
-from mbot_sim_bridge.core.range_sensor import HectorSonar
+from mbot_sim_bridge.core.joints.mimic_joint import MimicJoint
+from mbot_sim_bridge.core.sensors.range_sensor import HectorSonar
 from mbot_sim_bridge.plugins import registry
 from mbot_sim_bridge.plugins.registry import REGISTRY
 
@@ -77,9 +77,10 @@ print(" ".join(sorted(name for name in sys.modules if name.startswith("mbot_sim_
 def test_the_node_imports_only_the_plugins_it_looks_up():
     imported = set(subprocess.run([sys.executable, "-c", IMPORTED_PLUGIN_MODULES], capture_output=True, text=True,
                                   check=True).stdout.split())
-    assert {"mbot_sim_bridge.core.diff_drive", "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"} <= imported
+    assert {"mbot_sim_bridge.core.drives.diff_drive", "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"} <= imported
     # The simulation itself uses the joint state publisher (joints no plugin publishes) and the mimic joint.
-    used = {f"mbot_sim_bridge.core.{module}" for module in ("diff_drive", "joint_states", "mimic_joint")}
+    used = {f"mbot_sim_bridge.core.{module}" for module in ("drives.diff_drive", "joints.joint_states",
+                                                            "joints.mimic_joint")}
     assert not ({core_class.__module__ for core_class in CORE_PLUGINS.values()} - used) & imported
     assert not {module for module in imported if module.startswith("mbot_sim_bridge.plugins.gazebo_ros_")} - {
         "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"}

@@ -1,12 +1,12 @@
-"""Range finders on a ray sensor (core/range_sensor.py): libgazebo_ros_range.so and hector's sonar read a wall
+"""Range finders on a ray sensor (core/sensors/range_sensor.py): libgazebo_ros_range.so and hector's sonar read a wall
 at a known distance within 1 cm, max_range when clear, their field of view and noise as upstream."""
 import numpy as np
 import pytest
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.range_sensor import INFRARED, ULTRASOUND, HectorSonar, RangeSensor
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sensors.range_sensor import INFRARED, ULTRASOUND, HectorSonar, RangeSensor
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 SONAR = """<sensor type="ray" name="{name}">
   <pose>0 0 0 0 0 0</pose><update_rate>20</update_rate>

@@ -1,4 +1,4 @@
-"""core/ros_control/ and core/gazebo_ros_control.py: transmissions, limits, the PID, the diff
+"""core/ros_control/ and core/ros_control/gazebo_ros_control.py: transmissions, limits, the PID, the diff
 drive's odometry and speed limiter, the controller manager's state machine and texts, and the mbot and a
 two-joint arm driven through the controllers in the simulation, with no ROS master."""
 import logging

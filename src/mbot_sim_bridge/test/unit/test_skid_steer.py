@@ -1,4 +1,4 @@
-"""libgazebo_ros_skid_steer_drive.so (core/skid_steer_drive.py) on mobile_test_robots' skid-steer base: straight
+"""libgazebo_ros_skid_steer_drive.so (core/drives/skid_steer_drive.py) on mobile_test_robots' skid-steer base: straight
 lines within 5 %, turns the commanded way, ground-truth odometry, bad joints refused, NaN ignored, reset."""
 import math
 import os
@@ -8,8 +8,8 @@ import xacro_noetic as xacro
 from sensor_fixtures import drive_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.skid_steer_drive import SkidSteerDrive
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.drives.skid_steer_drive import SkidSteerDrive
 
 BASE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
                     "skid_steer_base.urdf.xacro")

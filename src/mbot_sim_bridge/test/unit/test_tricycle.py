@@ -1,5 +1,5 @@
-"""libgazebo_ros_tricycle_drive.so (core/tricycle_drive.py) on mobile_test_robots' tricycle: cmd_vel's linear.x is the
-front wheel's speed and angular.z the steering angle, as upstream reads them; in steady state the base moves as a
+"""libgazebo_ros_tricycle_drive.so (core/drives/tricycle_drive.py) on mobile_test_robots' tricycle: cmd_vel's linear.x
+is the front wheel's speed and angular.z the steering angle, as upstream reads them; in steady state the base moves as a
 tricycle's kinematics say within 5 %, both ways round, forwards and backwards; encoder odometry keeps the
 distance within 5 % (and upstream's heading sign); bad joints are refused, NaN ignored, reset stops it."""
 import math
@@ -11,8 +11,8 @@ from sensor_fixtures import drive_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.tricycle_drive import TricycleDrive
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.drives.tricycle_drive import TricycleDrive
 
 TRICYCLE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
                         "tricycle.urdf.xacro")

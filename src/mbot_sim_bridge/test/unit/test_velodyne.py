@@ -1,4 +1,4 @@
-"""Velodyne's lidar plugins (core/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
+"""Velodyne's lidar plugins (core/sensors/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
 in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
 import math
 import os
@@ -9,8 +9,8 @@ import xacro_noetic as xacro
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.velodyne_laser import VelodyneLaser
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.sensors.velodyne_laser import VelodyneLaser
 
 ROBOTS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots")
 STAND = """<robot name="stand" xmlns:xacro="http://www.ros.org/wiki/xacro">

@@ -19,15 +19,15 @@ from .body_wrenches import WORLD_FRAMES, BodyWrenches, WrenchJob, target_wrench
 from .engine import Engine, SpawnedRobot
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
-from .joint_states import JointStatePublisher
+from .joints.joint_states import JointStatePublisher
 from .log import get_logger, warn_once
-from .mimic_joint import MimicJoint
+from .joints.mimic_joint import MimicJoint
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext
 from .plugin_table import filename_of
-from .render_scene import RenderScene
-from .robot_model import RobotModel
-from .world_description import ModelDescription, WorldDescription
+from .cameras.render_scene import RenderScene
+from .description.robot_model import RobotModel
+from .description.world_description import ModelDescription, WorldDescription
 from .viewer import Viewer
 from .world_bodies import load_world
 

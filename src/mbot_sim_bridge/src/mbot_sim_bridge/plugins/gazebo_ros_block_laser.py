@@ -4,7 +4,7 @@ import rospy
 from geometry_msgs.msg import Point32
 from sensor_msgs.msg import ChannelFloat32, PointCloud
 
-from ..core.block_laser import BlockLaser
+from ..core.sensors.block_laser import BlockLaser
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 

@@ -3,7 +3,7 @@ import rospy
 from gazebo_msgs.msg import ContactsState, ContactState
 from geometry_msgs.msg import Vector3, Wrench
 
-from ..core.bumper import Bumper
+from ..core.sensors.bumper import Bumper
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import set_xyz

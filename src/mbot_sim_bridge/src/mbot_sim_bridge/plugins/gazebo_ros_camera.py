@@ -3,7 +3,7 @@ someone subscribes to either."""
 import rospy
 from sensor_msgs.msg import CameraInfo, Image
 
-from ..core.camera import Camera
+from ..core.cameras.camera import Camera
 from ..core.names import resolve_frame
 from . import RosPlugin, ros_time
 from .messages import camera_info_message, image_message

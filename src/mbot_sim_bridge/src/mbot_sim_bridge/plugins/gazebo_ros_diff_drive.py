@@ -5,7 +5,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
-from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
+from ..core.drives.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time

@@ -3,7 +3,7 @@ import rospy
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Empty, EmptyResponse
 
-from ..core.imu import ImuModelPlugin
+from ..core.sensors.imu import ImuModelPlugin
 from . import RosPlugin, resolve_in_namespace
 from .messages import imu_records
 

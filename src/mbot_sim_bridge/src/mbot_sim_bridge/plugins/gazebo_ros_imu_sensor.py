@@ -2,7 +2,7 @@
 import rospy
 from sensor_msgs.msg import Imu
 
-from ..core.imu import ImuSensor
+from ..core.sensors.imu import ImuSensor
 from . import RosPlugin, resolve_in_namespace
 from .messages import imu_message
 

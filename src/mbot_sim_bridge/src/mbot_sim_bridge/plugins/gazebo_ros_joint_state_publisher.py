@@ -1,7 +1,7 @@
 """``libgazebo_ros_joint_state_publisher.so``: sensor_msgs/JointState of the named joints."""
 from sensor_msgs.msg import JointState
 
-from ..core.joint_states import JointStatePublisher
+from ..core.joints.joint_states import JointStatePublisher
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 

@@ -2,7 +2,7 @@
 import rospy
 from sensor_msgs.msg import LaserScan
 
-from ..core.lidar import RaySensor
+from ..core.sensors.lidar import RaySensor
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 

@@ -2,7 +2,7 @@
 import rospy
 from nav_msgs.msg import Odometry
 
-from ..core.p3d import P3D
+from ..core.sensors.p3d import P3D
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance, set_pose, set_xyz
 

@@ -2,9 +2,9 @@
 import rospy
 from geometry_msgs.msg import Twist
 
-from ..core.diff_drive import ODOM_POSE_COVARIANCE
+from ..core.drives.diff_drive import ODOM_POSE_COVARIANCE
 from ..core.names import resolve_frame, tf_prefix
-from ..core.planar_move import PlanarMove
+from ..core.drives.planar_move import PlanarMove
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
 from .ground_truth_odometry import OdometryOutput

@@ -3,7 +3,7 @@ import rospy
 from sensor_msgs.msg import Range
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.range_sensor import RangeSensor
+from ..core.sensors.range_sensor import RangeSensor
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 

@@ -5,7 +5,7 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.tricycle_drive import TricycleDrive
+from ..core.drives.tricycle_drive import TricycleDrive
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .gazebo_ros_diff_drive import on_twist

@@ -5,7 +5,7 @@ import rospy
 from sensor_msgs.msg import PointCloud2, PointField
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.velodyne_laser import VelodyneLaser
+from ..core.sensors.velodyne_laser import VelodyneLaser
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 POINT = np.dtype({"names": ["x", "y", "z", "intensity", "ring", "time"],

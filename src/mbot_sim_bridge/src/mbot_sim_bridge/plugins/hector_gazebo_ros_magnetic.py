@@ -4,7 +4,7 @@ import rospy
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import MagneticField
 
-from ..core.hector_magnetic import HectorMagnetic
+from ..core.hector.hector_magnetic import HectorMagnetic
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import set_xyz
 
