@@ -7,7 +7,8 @@ import numpy as np
 import pybullet
 import pytest
 
-from mbot_sim_bridge.core.cameras.camera import Camera, CameraConfig, DepthCamera, Intrinsics, camera_intrinsics
+from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera, Intrinsics, camera_intrinsics
+from mbot_sim_bridge.core.cameras.render_scene import CameraConfig
 from mbot_sim_bridge.core.cameras.image_formats import (convert_image, depth_16uc1, depth_in_range, image_encoding,
                                                 linear_depth, point_cloud)
 from mbot_sim_bridge.core.errors import ConfigError

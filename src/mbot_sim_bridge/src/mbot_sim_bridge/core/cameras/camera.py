@@ -24,7 +24,6 @@ Gazebo's default background, 0.7 grey. World models are drawn from their collisi
 runs at the plugin's ``updateRate``, or at 30 Hz when that is 0 too.
 """
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from typing import NamedTuple, Optional, Tuple
 
 import numpy as np
@@ -34,12 +33,12 @@ from ..clock import UpdateTimer
 from ..errors import ConfigError
 from .image_formats import (FORMAT_ENCODINGS, add_image_noise, convert_image, depth_16uc1, depth_in_range,
                             image_encoding, point_cloud)
-from ..geometry import IDENTITY, Pose, compose
+from ..geometry import Pose, compose
 from ..log import get_logger, info_once, warn_once
 from ..params import Param, PluginParams, non_negative, positive
 from ..plugin import Plugin
 from ..sensors.sensor_elements import gaussian_noise, sensor_label, sensor_pose
-from .render_scene import CameraRenderer
+from .render_scene import CameraConfig, CameraRenderer
 from ..xml_values import XmlDocument
 
 _log = get_logger(__name__)
@@ -102,28 +101,6 @@ DEPTH_PARAMS = CAMERA_PARAMS + (
 )
 # libgazebo_ros_depth_camera.so: no cutoffMax; its reflectance and normals topics are not produced.
 DEPTH_CAMERA_PARAMS = tuple(param for param in DEPTH_PARAMS if param.tag != "pointCloudCutoffMax")
-
-@dataclass(frozen=True)
-class CameraConfig:
-    """One camera sensor's SDF values; lengths in m, angles in rad."""
-
-    sensor_name: str
-    link: str
-    width: int = 320
-    height: int = 240
-    hfov: float = 1.047
-    image_format: str = "R8G8B8"
-    near: float = 0.1
-    far: float = 100.0
-    pose: Pose = IDENTITY  # of the sensor in the link frame
-    update_rate: float = 0.0
-    noise_mean: float = 0.0
-    noise_stddev: Optional[float] = None  # None: no noise
-
-    @property
-    def focal_length(self) -> float:
-        return self.width / (2.0 * np.tan(self.hfov / 2.0))
-
 
 def parse_camera_sensor(sensor: ET.Element, link: str, document: XmlDocument) -> CameraConfig:
     """Read ``<sensor type="camera"|"depth">``; bad values raise ConfigError naming where and what."""

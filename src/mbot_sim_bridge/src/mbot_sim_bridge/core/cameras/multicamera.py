@@ -13,15 +13,15 @@ import xml.etree.ElementTree as ET
 from typing import Dict, NamedTuple
 
 from .. import names
-from .camera import (CAMERA_IGNORED_TAGS, CAMERA_PARAMS, CAMERA_SENSOR_PARAMS, DEFAULT_FRAME_RATE, CameraConfig, Frame,
-                     Intrinsics, Throttle, camera_intrinsics, parse_camera_sensor)
+from .camera import (CAMERA_IGNORED_TAGS, CAMERA_PARAMS, CAMERA_SENSOR_PARAMS, DEFAULT_FRAME_RATE, Frame, Intrinsics,
+                     Throttle, camera_intrinsics, parse_camera_sensor)
 from ..clock import UpdateTimer
 from ..errors import ConfigError
 from ..geometry import Pose, compose
 from .image_formats import FORMAT_ENCODINGS, add_image_noise, convert_image, image_encoding
 from ..log import get_logger, warn_once
 from ..plugin import Plugin
-from .render_scene import CameraRenderer
+from .render_scene import CameraConfig, CameraRenderer
 from ..sensors.sensor_elements import sensor_label, sensor_pose
 
 _log = get_logger(__name__)

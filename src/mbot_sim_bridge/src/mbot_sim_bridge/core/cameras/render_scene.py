@@ -3,19 +3,17 @@ render of colour and depth from a sensor pose."""
 import os
 import pkgutil
 import tempfile
-from typing import TYPE_CHECKING, Dict, Optional, Tuple
+from dataclasses import dataclass
+from typing import Dict, Optional, Tuple
 
 import numpy as np
 import pybullet
 
-from ..geometry import Pose, compose, inverse, rotation_matrix
+from ..geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
 from .image_formats import linear_depth
 from ..log import get_logger, info_once, warn_once
 from ..description.materials import colour_robot
 from ..pybullet_shapes import DEFAULT_WORLD_RGBA, visual_shape, welded_body
-
-if TYPE_CHECKING:  # for the annotation only: camera.py imports this module
-    from .camera import CameraConfig
 
 _log = get_logger(__name__)
 
@@ -123,10 +121,32 @@ def _plain_colours(client, body: int, model):
         client.changeVisualShape(body, index, textureUniqueId=-1, rgbaColor=list(rgba))
 
 
+@dataclass(frozen=True)
+class CameraConfig:
+    """One camera sensor's SDF values; lengths in m, angles in rad."""
+
+    sensor_name: str
+    link: str
+    width: int = 320
+    height: int = 240
+    hfov: float = 1.047
+    image_format: str = "R8G8B8"
+    near: float = 0.1
+    far: float = 100.0
+    pose: Pose = IDENTITY  # of the sensor in the link frame
+    update_rate: float = 0.0
+    noise_mean: float = 0.0
+    noise_stddev: Optional[float] = None  # None: no noise
+
+    @property
+    def focal_length(self) -> float:
+        return self.width / (2.0 * np.tan(self.hfov / 2.0))
+
+
 class CameraRenderer:
     """Renders one camera's colour and depth in one call, from a sensor pose in the world."""
 
-    def __init__(self, client, config: "CameraConfig", scene: Optional[RenderScene] = None):
+    def __init__(self, client, config: CameraConfig, scene: Optional[RenderScene] = None):
         self._client = client
         self._config = config
         self._scene = scene
