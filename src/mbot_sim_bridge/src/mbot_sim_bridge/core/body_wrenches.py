@@ -20,9 +20,8 @@ from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from .errors import ModelError
-from .geometry import Pose, inverse, compose, rotate
+from .geometry import Pose, Vector, inverse, compose, rotate
 
-Vector = Tuple[float, float, float]
 ZERO = (0.0, 0.0, 0.0)
 WORLD_FRAMES = ("", "world", "map", "/map")
 # apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).

@@ -19,7 +19,7 @@ from typing import NamedTuple, Optional, Tuple
 
 
 from .. import names
-from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
+from .hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
 from ..params import Param, non_negative
 from ..plugin import Plugin

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import names
 from ..geometry import rotation_matrix
-from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
+from .hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
 from ..params import ERROR_MODEL_LIMIT, Param, non_negative
 from ..plugin import Plugin

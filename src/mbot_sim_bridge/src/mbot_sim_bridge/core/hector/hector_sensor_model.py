@@ -1,4 +1,4 @@
-"""hector_gazebo_plugins' sensor error model (``sensor_model.h``, ``update_timer.h``), shared by its IMU and GPS.
+"""hector_gazebo_plugins' sensor error model (``sensor_model.h``), shared by its IMU, GPS, magnetometer and sonar.
 
 Per axis: ``measured = value · scaleError + offset + drift + n``, where n ~ N(0, gaussianNoise) is drawn on
 every update and the drift is a first-order Gauss-Markov process,

@@ -14,13 +14,13 @@ Bullet reports contacts per link, not per collision, so when several collisions 
 link (a bumper plate on a fixed joint), a contact point counts as the collision whose box (in the link frame)
 it lies nearest to.
 """
-from typing import List, NamedTuple, Optional, Tuple
+from typing import List, NamedTuple, Optional
 
 import numpy as np
 
 from .. import names
 from ..clock import UpdateTimer
-from ..geometry import IDENTITY, Pose, compose, inverse
+from ..geometry import IDENTITY, Pose, Vector, compose, inverse
 from ..log import get_logger, warn_once
 from ..params import Param, PluginParams, non_negative
 from ..plugin import Plugin
@@ -28,7 +28,6 @@ from .sensor_elements import sensor_label
 
 _log = get_logger(__name__)
 
-Vector = Tuple[float, float, float]
 
 
 class ContactPoint(NamedTuple):

@@ -7,16 +7,16 @@ the last physics step (``body_wrenches.py``), zero otherwise. ``frameName`` only
 says it is "not used, default to world" and still puts it there, with the tf prefix). ``bodyName`` must be a
 link Gazebo keeps (one lumped by a fixed joint is not found, as in Gazebo).
 """
-from typing import NamedTuple, Optional, Tuple
+from typing import NamedTuple, Optional
 
 from .. import names
 from ..clock import UpdateTimer
 from ..errors import ConfigError
-from .imu import IDLE_PERIOD
+from ..geometry import Vector
+from .body_sensors import IDLE_PERIOD
 from ..params import Param
 from ..plugin import Plugin
 
-Vector = Tuple[float, float, float]
 
 
 class AppliedWrench(NamedTuple):

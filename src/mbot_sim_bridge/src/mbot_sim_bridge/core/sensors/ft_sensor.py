@@ -19,12 +19,11 @@ import numpy as np
 from .. import names
 from ..clock import UpdateTimer
 from ..errors import ConfigError
-from .imu import IDLE_PERIOD
-from ..geometry import rotation_matrix
+from .body_sensors import IDLE_PERIOD
+from ..geometry import Vector, rotation_matrix
 from ..params import ERROR_MODEL_LIMIT, Param, non_negative
 from ..plugin import Plugin
 
-Vector = Tuple[float, float, float]
 
 
 class JointWrench(NamedTuple):

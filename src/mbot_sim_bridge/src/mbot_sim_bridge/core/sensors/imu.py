@@ -38,19 +38,14 @@ import numpy as np
 from .. import names
 from ..clock import EveryStopTimer, UpdateTimer
 from ..errors import ConfigError
-from ..geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrix
+from ..geometry import IDENTITY, Pose, Vector, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrix
 from ..log import get_logger, warn_once
 from ..params import ERROR_MODEL_LIMIT, Param, PluginParams, non_negative
 from ..plugin import Plugin
+from .body_sensors import IDLE_PERIOD, gazebo_body, read_vector_param
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
-from ..xml_values import parse_floats
 
 _log = get_logger(__name__)
-
-Vector = Tuple[float, float, float]
-# Sim seconds between looks at an every-step plugin (updateRate 0) while nothing subscribes: Gazebo computes
-# nothing then either, and a timer due on every step would keep the loop at one physics step per pass.
-IDLE_PERIOD = 0.05
 
 
 class ImuReading(NamedTuple):
@@ -72,22 +67,6 @@ class ImuReadings(NamedTuple):
     def last(self) -> ImuReading:
         return ImuReading(float(self.stamps[-1]), tuple(self.orientations[-1]), tuple(self.angular_velocities[-1]),
                           tuple(self.linear_accelerations[-1]), self.covariance)
-
-
-def read_vector_param(element: ET.Element, tag: str, label: str, where: str) -> Optional[Vector]:
-    """A three-number tag (xyzOffset, rpyOffset) or None when absent; ConfigError naming it when bad."""
-    child = element.find(tag)
-    if child is None or not (child.text or "").strip():
-        return None
-    try:
-        return parse_floats(child.text, 3)
-    except ValueError as error:
-        raise ConfigError(f"{where}: {label}: <{tag}> has bad value '{child.text.strip()}': {error}") from None
-
-
-def gazebo_body(robot, name: str) -> Tuple[str, Pose]:
-    """The link Gazebo keeps for URDF link ``name`` (fixed joints lumped) and ``name``'s pose in it."""
-    return robot.model.lumped_into[name]
 
 
 class _VelocityDifference:

@@ -21,7 +21,7 @@ from .. import names
 from ..clock import UpdateTimer
 from ..errors import ConfigError
 from ..geometry import Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
-from .imu import IDLE_PERIOD, read_vector_param
+from .body_sensors import IDLE_PERIOD, read_vector_param
 from ..params import ERROR_MODEL_LIMIT, Param, non_negative
 from ..plugin import Plugin
 

@@ -15,7 +15,7 @@ from typing import NamedTuple, Optional
 
 from .. import names
 from ..clock import UpdateTimer
-from ..hector.hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, update_timer
+from ..hector.hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, update_timer
 from ..hector.hector_sensor_model import SensorModel, sensor_model_params
 from .lidar import RaySensor
 from ..params import ERROR_MODEL_LIMIT, Param, non_negative
