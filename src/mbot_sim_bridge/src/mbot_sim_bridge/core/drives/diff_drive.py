@@ -6,15 +6,15 @@ joints from the last command; the ROS plugin feeds it cmd_vel and publishes what
 """
 import logging
 import math
-import threading
 from dataclasses import dataclass
 from typing import Tuple
 
 from .. import names
 from ..clock import UpdateTimer
-from ..geometry import Pose, yaw
+from ..geometry import Pose
 from ..params import Param, non_negative
 from ..plugin import Plugin
+from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
 # Below a millimetre a wheel or a track width is a typo (0, 1e-300) that makes the wheel speeds explode.
 MINIMUM_WHEEL_SIZE = 0.001
@@ -118,48 +118,8 @@ class EncoderOdometry:
             self.angular = delta_theta / dt
 
 
-def yaw_rotated_velocity(world_linear, yaw: float) -> Tuple[float, float]:
-    """World-frame linear velocity rotated by yaw only, as the plugin's world odometry twist is."""
-    vx, vy = world_linear[0], world_linear[1]
-    return math.cos(yaw) * vx + math.sin(yaw) * vy, math.cos(yaw) * vy - math.sin(yaw) * vx
-
-
-ODOM_POSE_COVARIANCE = (1e-5, 0, 0, 0, 0, 0,
-                        0, 1e-5, 0, 0, 0, 0,
-                        0, 0, 1e12, 0, 0, 0,
-                        0, 0, 0, 1e12, 0, 0,
-                        0, 0, 0, 0, 1e12, 0,
-                        0, 0, 0, 0, 0, 1e-3)
-
-
 _LOG_LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warn": logging.WARNING, "error": logging.ERROR,
                "fatal": logging.CRITICAL}
-
-
-class TwistCommand:
-    """The last valid cmd_vel (linear.x, angular.z) of a drive, stored from ROS threads, read by the loop; mixed
-    in before Plugin."""
-
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self._lock = threading.Lock()
-        self._command = (0.0, 0.0)
-
-    def set_command(self, linear: float, angular: float) -> bool:
-        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            return False
-        with self._lock:
-            self._command = (linear, angular)
-        return True
-
-    def command(self) -> Tuple[float, float]:
-        with self._lock:
-            return self._command
-
-    def stop(self):
-        with self._lock:
-            self._command = (0.0, 0.0)
 
 
 class DiffDrive(TwistCommand, Plugin):
@@ -207,16 +167,13 @@ class DiffDrive(TwistCommand, Plugin):
             robot.set_joint_velocity(joint, speed / radius, self.torque)
         self.last_update = now
 
-    def odometry(self) -> Tuple[Pose, Tuple[float, float], float]:
-        """(pose, body-frame (vx, vy), ωz) as the plugin's odometry reports them for its odometrySource."""
+    def odometry(self) -> DriveOdometry:
+        """The odometry the plugin reports for its odometrySource."""
         if self.encoder is None:
-            robot = self.context.robot
-            root = robot.root_pose()
-            linear, angular = robot.root_velocity()
-            return root, yaw_rotated_velocity(linear, yaw(root.orientation)), angular[2]
+            return ground_truth_odometry(self.context.robot)
         encoder = self.encoder
         pose = Pose((encoder.x, encoder.y, 0.0), (0.0, 0.0, math.sin(encoder.theta / 2), math.cos(encoder.theta / 2)))
-        return pose, (encoder.linear, 0.0), encoder.angular
+        return DriveOdometry(pose, (encoder.linear, 0.0), encoder.angular)
 
     def reset(self, now: float):
         super().reset(now)

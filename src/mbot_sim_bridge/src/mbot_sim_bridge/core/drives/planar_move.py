@@ -9,27 +9,21 @@ since the last one (the commanded angular.z when it exceeds π per period), rota
 and the odom -> base TF.
 """
 import math
-import threading
-from typing import NamedTuple, Optional, Tuple
+from typing import Optional
 
 from .. import names
 from ..clock import UpdateTimer
-from .diff_drive import yaw_rotated_velocity
-from ..geometry import Pose, yaw
+from ..geometry import yaw
 from ..params import Param
 from ..plugin import Plugin
+from .twist_drive import DriveOdometry, TwistCommand, yaw_rotated_velocity
 
 
-class PlanarOdometry(NamedTuple):
-    pose: Pose
-    linear: Tuple[float, float]  # base frame
-    angular: float
-
-
-class PlanarMove(Plugin):
+class PlanarMove(TwistCommand, Plugin):
     """Core of libgazebo_ros_planar_move.so (GazeboRosPlanarMove)."""
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "PlanarMovePlugin"
+    COMMAND_AXES = ("linear.x", "linear.y", "angular.z")
     PARAMS = (
         Param("robotNamespace", str, "", "namespace of the topics", warn_if_missing=False),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist: linear.x, linear.y (robot frame), angular.z"),
@@ -48,31 +42,13 @@ class PlanarMove(Plugin):
         rate = params["odometryRate"]
         # Disabled odometry: a timer that never comes due within any run.
         self.timer = UpdateTimer(rate if rate > 0 else 1e-12, strict=True, start=now)
-        self._lock = threading.Lock()  # commands arrive from other threads
-        self._command = (0.0, 0.0, 0.0)
-        self._command_time: Optional[float] = None
+        self.command_timeout = params["cmdTimeout"]
         self.last_pose = context.robot.root_pose()
         self.last_odometry_time = now
-        self.latest: Optional[PlanarOdometry] = None
-
-    def set_command(self, x: float, y: float, rotation: float) -> bool:
-        """Store a body twist; a non-finite one is refused (False) and the last valid one stays."""
-        if not all(math.isfinite(value) for value in (x, y, rotation)):
-            return False
-        with self._lock:
-            self._command = (x, y, rotation)
-            self._command_time = None  # stamped by the loop, in sim time, at the next step
-        return True
+        self.latest: Optional[DriveOdometry] = None
 
     def on_step(self, step_size: float):
-        now = self.context.simulation.sim_time
-        with self._lock:
-            if self._command_time is None:
-                self._command_time = now
-            timeout = self.params["cmdTimeout"]
-            if timeout >= 0 and now - self._command_time > timeout:
-                self._command = (0.0, 0.0, 0.0)
-            x, y, rotation = self._command
+        x, y, rotation = self.command(self.context.simulation.sim_time)
         robot = self.context.robot
         heading = yaw(robot.root_pose().orientation)
         cos_h, sin_h = math.cos(heading), math.sin(heading)
@@ -84,17 +60,15 @@ class PlanarMove(Plugin):
         pose = self.context.robot.root_pose()
         linear = ((pose.position[0] - self.last_pose.position[0]) / period,
                   (pose.position[1] - self.last_pose.position[1]) / period)
-        with self._lock:
-            rotation = self._command[2]
+        rotation = self.command()[2]
         if rotation > math.pi / period:
             angular = rotation
         else:
             angular = math.remainder(yaw(pose.orientation) - yaw(self.last_pose.orientation), 2 * math.pi) / period
         self.last_pose, self.last_odometry_time = pose, now
-        self.latest = PlanarOdometry(pose, yaw_rotated_velocity(linear, yaw(pose.orientation)), angular)
+        self.latest = DriveOdometry(pose, yaw_rotated_velocity(linear, yaw(pose.orientation)), angular)
 
     def reset(self, now: float):
         super().reset(now)
-        with self._lock:
-            self._command, self._command_time = (0.0, 0.0, 0.0), None
+        self.stop()
         self.last_pose, self.last_odometry_time = self.context.robot.root_pose(), now

@@ -7,22 +7,15 @@ four wheels get velocity motors of at most ``torque``: right wheels v + ω·s/2,
 the wheel radius. ``broadcastTF`` (default false) adds the odom -> base TF. The last cmd_vel holds until
 another comes or a reset; a NaN or infinite one is ignored.
 """
-from typing import NamedTuple, Optional, Tuple
+from typing import Optional
 
 from .. import names
 from ..clock import UpdateTimer
-from .diff_drive import TwistCommand, yaw_rotated_velocity
-from ..geometry import Pose, yaw
 from ..params import Param, non_negative, positive
 from ..plugin import Plugin
+from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
 WHEEL_TAGS = ("leftFrontJoint", "rightFrontJoint", "leftRearJoint", "rightRearJoint")
-
-
-class SkidSteerOdometry(NamedTuple):
-    pose: Pose
-    linear: Tuple[float, float]  # base frame (yaw only)
-    angular: float
 
 
 class SkidSteerDrive(TwistCommand, Plugin):
@@ -55,13 +48,11 @@ class SkidSteerDrive(TwistCommand, Plugin):
         self.joints = self.named_joints(params, WHEEL_TAGS)
         self.driven_joints = self.joints
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=context.simulation.sim_time)
-        self.latest: Optional[SkidSteerOdometry] = None
+        self.latest: Optional[DriveOdometry] = None
 
     def update(self, now: float):
         robot = self.context.robot
-        pose = robot.root_pose()
-        linear, angular = robot.root_velocity()
-        self.latest = SkidSteerOdometry(pose, yaw_rotated_velocity(linear, yaw(pose.orientation)), angular[2])
+        self.latest = ground_truth_odometry(robot)
         speed, turn = self.command()
         half_track = turn * self.params["wheelSeparation"] / 2.0
         radius = self.params["wheelDiameter"] / 2.0

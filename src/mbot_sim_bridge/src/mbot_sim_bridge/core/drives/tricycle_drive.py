@@ -18,25 +18,19 @@ Encoder odometry integrates the encoder wheels' speeds every physics step, with 
 (left − right) / separation: it turns the opposite way to the robot, as upstream's does.
 """
 import math
-from typing import NamedTuple, Optional, Tuple
+from typing import Optional
 
 from .. import names
 from ..clock import UpdateTimer
-from .diff_drive import TwistCommand, yaw_rotated_velocity
-from ..geometry import Pose, pose_from_xyz_rpy, yaw
+from ..geometry import pose_from_xyz_rpy
 from ..params import Param, non_negative, positive
 from ..plugin import Plugin
 from ..ros_control.hardware_interface import UNBOUNDED_EFFORT
+from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
 JOINT_TAGS = ("steeringJoint", "actuatedWheelJoint", "encoderWheelLeftJoint", "encoderWheelRightJoint")
 ODOMETRY_SOURCES = ("world", "encoder")
 MAX_STEERING_ANGLE = math.pi / 2
-
-
-class TricycleOdometry(NamedTuple):
-    pose: Pose
-    linear: Tuple[float, float]
-    angular: float
 
 
 class TricycleDrive(TwistCommand, Plugin):
@@ -85,7 +79,7 @@ class TricycleDrive(TwistCommand, Plugin):
         self.timer = UpdateTimer(params["updateRate"], strict=True, start=now)
         self.last_update = now
         self._reset_encoder(now)
-        self.latest: Optional[TricycleOdometry] = None
+        self.latest: Optional[DriveOdometry] = None
 
     def _reset_encoder(self, now: float):
         self.encoder_pose = (0.0, 0.0, 0.0)  # x, y, heading
@@ -110,15 +104,12 @@ class TricycleDrive(TwistCommand, Plugin):
         self.encoder_pose = (x + dx, y + dy, heading + turn)
         self.encoder_twist = ((dx / dt, dy / dt), turn / dt)
 
-    def odometry(self) -> TricycleOdometry:
+    def odometry(self) -> DriveOdometry:
         if self.encoder:
             x, y, heading = self.encoder_pose
             linear, angular = self.encoder_twist
-            return TricycleOdometry(pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, heading)), linear, angular)
-        robot = self.context.robot
-        pose = robot.root_pose()
-        linear, angular = robot.root_velocity()
-        return TricycleOdometry(pose, yaw_rotated_velocity(linear, yaw(pose.orientation)), angular[2])
+            return DriveOdometry(pose_from_xyz_rpy((x, y, 0.0), (0.0, 0.0, heading)), linear, angular)
+        return ground_truth_odometry(self.context.robot)
 
     def update(self, now: float):
         dt = now - self.last_update
