@@ -21,7 +21,7 @@ class GazeboRosBlockLaser(RosPlugin, BlockLaser):
                       f"of {config.range_count} points at {config.update_rate:g} Hz")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         cloud = self.cloud()
         message = PointCloud()

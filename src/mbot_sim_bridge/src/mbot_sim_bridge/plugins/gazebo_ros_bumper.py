@@ -32,7 +32,7 @@ class GazeboRosBumper(RosPlugin, Bumper):
         rospy.loginfo(f"{self.label}: contacts of '{self.collision_name}' -> {self.publisher.resolved_name}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         message = ContactsState()

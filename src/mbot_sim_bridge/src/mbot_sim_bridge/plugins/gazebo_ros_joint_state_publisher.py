@@ -12,7 +12,7 @@ class GazeboRosJointStatePublisher(RosPlugin, JointStatePublisher):
         self.message = JointState(name=self.joint_names)  # refilled at each update
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         message = self.message
         message.header.stamp = ros_time(now)

@@ -26,7 +26,7 @@ class GazeboRosLaser(RosPlugin, RaySensor):
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor works only while someone listens.
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         scan = self.scan()
         self.message.header.stamp = ros_time(now)

@@ -17,8 +17,7 @@ class GazeboRosP3D(RosPlugin, P3D):
                       f"'{self.frame_name}' {rate}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
-            self.idle(now)
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         truth = self.latest

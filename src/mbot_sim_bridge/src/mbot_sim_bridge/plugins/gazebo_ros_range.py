@@ -21,7 +21,7 @@ class RangePublisher(RosPlugin):
                       f"{self.publisher.resolved_name} (frame {frame_id})")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         self.message.header.stamp = ros_time(now)

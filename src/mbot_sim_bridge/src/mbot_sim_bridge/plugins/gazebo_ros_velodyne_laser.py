@@ -32,7 +32,7 @@ class GazeboRosVelodyneLaser(RosPlugin, VelodyneLaser):
                       f"of {config.range_count} at {config.update_rate:g} Hz")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         cloud = self.cloud()
         points = np.zeros(len(cloud.ring), dtype=POINT)

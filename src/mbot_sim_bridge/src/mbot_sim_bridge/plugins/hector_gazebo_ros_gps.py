@@ -29,7 +29,7 @@ class HectorGazeboRosGps(RosPlugin, HectorGps):
                       f"{self.velocity_publisher.resolved_name} (frame '{self.frame_id}')")
 
     def update(self, now: float):
-        if not self.topics.listened(self.fix_publisher, self.velocity_publisher):
+        if self.nobody_listens(now, self.fix_publisher, self.velocity_publisher):
             return
         super().update(now)
         reading = self.latest

@@ -49,7 +49,7 @@ class HectorGazeboRosImu(RosPlugin, HectorImu):
         return EmptyResponse()
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher, self.bias_publisher):
+        if self.nobody_listens(now, self.publisher, self.bias_publisher):
             return
         super().update(now)
         reading = self.latest

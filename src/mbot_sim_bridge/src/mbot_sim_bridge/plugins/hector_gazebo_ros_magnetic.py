@@ -19,7 +19,7 @@ class HectorGazeboRosMagnetic(RosPlugin, HectorMagnetic):
         rospy.loginfo(f"{self.label}: link '{self.link}' -> {self.publisher.resolved_name} (frame '{self.frame_id}')")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         message = MagneticField() if self.as_magnetic_field else Vector3Stamped()
