@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 import pytest
+from sensor_fixtures import plugin_of
 
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import ConfigError
@@ -22,10 +23,6 @@ WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds
 
 def simulation(world="empty.world", seed=0):
     return Simulation(parse_world(os.path.join(WORLDS, world)), CORE_PLUGINS, seed=seed)
-
-
-def plugin_of(spawned, plugin_class):
-    return next(plugin for plugin in spawned.plugins if isinstance(plugin, plugin_class))
 
 
 def test_spawn_command_step_and_read_odometry(mbot_urdf):

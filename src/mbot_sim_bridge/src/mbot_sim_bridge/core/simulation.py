@@ -376,6 +376,12 @@ class Simulation:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
                 self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
 
+    def __enter__(self) -> "Simulation":
+        return self
+
+    def __exit__(self, *exception):
+        self.close()
+
     def close(self):
         for name in list(self.models):
             for plugin in self.models.pop(name).plugins:
