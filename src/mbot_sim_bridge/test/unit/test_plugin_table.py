@@ -1,5 +1,6 @@
 """The one plugin table: the ROS registry derived from it, both loaded per file name, no copy of the table
 elsewhere, added plugin blocks checked."""
+import ast
 import importlib
 import os
 import pkgutil
@@ -17,7 +18,10 @@ from mbot_sim_bridge.core.sensors.range_sensor import HectorSonar
 from mbot_sim_bridge.plugins import registry
 from mbot_sim_bridge.plugins.registry import REGISTRY
 
-WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
+UNIT_TESTS = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(UNIT_TESTS, "..", "..", "..", ".."))
+PACKAGE_SOURCE = os.path.join(UNIT_TESTS, "..", "..", "src")
+README = os.path.join(UNIT_TESTS, "..", "..", "README.md")
 # A dictionary entry keyed by a plugin's file name: how a copy of the table would look.
 TABLE_ENTRY = re.compile(r"""["']lib\w+\.so["']\s*:""")
 
@@ -48,6 +52,30 @@ def test_every_plugin_class_of_the_ros_package_is_reachable_through_the_registry
         for plugin_class in registry.plugin_classes(module):
             in_use = plugin_class in registered or any(issubclass(ros_class, plugin_class) for ros_class in registered)
             assert in_use, f"{module.__name__}.{plugin_class.__name__}"
+
+
+def _modules_imported_by_tests():
+    """Test module -> the modules it imports (the checks of this file and of the README's tables left out)."""
+    imported = {}
+    for name in os.listdir(UNIT_TESTS):
+        if name.endswith(".py") and name not in ("test_plugin_table.py", "test_readme.py"):
+            tree = ast.parse(open(os.path.join(UNIT_TESTS, name)).read())
+            imported[name] = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    return imported
+
+
+@pytest.mark.parametrize("filename", sorted(CORE_PLUGINS))
+def test_every_plugin_has_the_five_files_of_the_readme_recipe(filename):
+    """README "Adding a plugin": the core module, the ROS module, the table line, the README's row and tag table,
+    and a unit test of the core class."""
+    core_class = CORE_PLUGINS[filename]  # the table line names a core class that imports
+    core_module = core_class.__module__
+    assert os.path.isfile(os.path.join(PACKAGE_SOURCE, *core_module.split(".")) + ".py")
+    ros_module = registry.home_module(filename)
+    assert os.path.isfile(os.path.join(PACKAGE_SOURCE, *ros_module.split(".")) + ".py"), f"{ros_module} is missing"
+    assert f"`{filename}`" in open(README).read(), f"{filename} is not in the README's supported-plugin table"
+    tests = [name for name, modules in _modules_imported_by_tests().items() if core_module in modules]
+    assert tests, f"no unit test under test/unit imports {core_module}"
 
 
 def test_a_second_file_name_shares_the_first_ones_ros_module():

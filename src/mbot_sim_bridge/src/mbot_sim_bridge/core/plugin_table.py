@@ -41,6 +41,8 @@ _REFERENCES: Dict[str, str] = {
     "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": "joints.mimic_joint.MimicJoint",
     # The same plugin under the package's name before 2020.
     "libroboticsgroup_gazebo_mimic_joint_plugin.so": "joints.mimic_joint.MimicJoint",
+    # gazebo_plugins' template, which does nothing: the starting point of a new plugin.
+    "libgazebo_ros_template.so": "template.Template",
 }
 
 
