@@ -10,7 +10,7 @@ import pytest
 from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera, Intrinsics, camera_intrinsics
 from mbot_sim_bridge.core.cameras.render_scene import CameraConfig
 from mbot_sim_bridge.core.cameras.image_formats import (convert_image, depth_16uc1, depth_in_range, image_encoding,
-                                                linear_depth, point_cloud)
+                                                        linear_depth, point_cloud)
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.description.robot_model import parse_robot

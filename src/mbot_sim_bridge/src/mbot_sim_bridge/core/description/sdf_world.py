@@ -21,7 +21,7 @@ from .model_path import MODEL_MANIFESTS, default_model_path, find_model_director
 from .world_description import (SHAPE_KINDS, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
 from ..xml_values import (XmlDocument, parse_xml, read_bool, read_bool_attribute, read_number, read_pose,
-                         read_text, read_vector, read_xml_file)
+                          read_text, read_vector, read_xml_file)
 
 _log = get_logger(__name__)
 
