@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 from mbot_sim_bridge.processes import stop_process_group
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 from ros_processes import TESTS, call_service, run, service_up, wait_until
 

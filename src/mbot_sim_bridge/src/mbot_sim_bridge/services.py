@@ -23,9 +23,9 @@ from .core.engine import check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .gazebo_paths import model_path
-from .core.robot_model import parse_robot
-from .core.sdf_spawn import spawn_world_xml
-from .core.sdf_world import parse_world
+from .core.description.robot_model import parse_robot
+from .core.description.sdf_spawn import spawn_world_xml
+from .core.description.sdf_world import parse_world
 from .model_states import ModelStatesPublisher
 from .package_uris import resolve_package_uris
 from .plugins import ros_time

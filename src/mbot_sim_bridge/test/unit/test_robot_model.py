@@ -4,7 +4,7 @@ import os
 import pytest
 
 from mbot_sim_bridge.core.errors import ModelError
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 LINK = '<link name="{name}">{inertial}<collision><geometry>{geometry}</geometry></collision></link>'
 INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'

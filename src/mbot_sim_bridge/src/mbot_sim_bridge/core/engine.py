@@ -19,8 +19,8 @@ from .errors import ModelError
 from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotation_matrices,
                        rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
-from .robot_model import RobotModel
-from .world_description import PhysicsConfig
+from .description.robot_model import RobotModel
+from .description.world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
 from .xml_values import check_range, parse_float
 

@@ -12,7 +12,7 @@ from typing import Dict, List, Optional, Sequence
 
 from ..errors import ConfigError
 from ..log import get_logger, info_once, warn_once
-from ..robot_model import RobotModel
+from ..description.robot_model import RobotModel
 from .angles import normalize_angle, position_error
 from .control_toolbox import Pid, clamp
 from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,

@@ -1,0 +1,505 @@
+"""robot_description (URDF after xacro) -> what the simulator needs, the way Gazebo's URDF import sees it.
+
+Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
+- fixed joints are lumped into their parent (PyBullet does the same with URDF_MERGE_FIXED_LINKS), so each
+  URDF link maps to a simulated body link plus a fixed offset;
+- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia,
+  so it gets a negligible inertial in the URDF handed to PyBullet);
+- a link with no ``<inertial>`` on a moving joint is not simulated, together with its subtree (with a warning);
+- ``<gazebo reference="...">`` blocks are collected per link; model-level ``<gazebo>`` blocks carry plugins.
+"""
+import copy
+import math
+import os
+import stat
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+from xml.etree import ElementTree
+
+from ..errors import ModelError
+from ..geometry import IDENTITY, Pose, compose
+from ..log import get_logger, warn_once
+from ..xml_values import XmlDocument, check_range, parse_floats, parse_xml, read_attribute_numbers, read_origin
+
+_logger = get_logger(__name__)
+
+MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
+# PyBullet's URDF importer knows these; planar and floating joints are not importable into a multibody.
+SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
+
+# <gazebo reference="link"> tags the bridge acts on.
+LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor")
+# Tags whose Gazebo default is what Bullet does anyway: only another value is reported (value -> default).
+LINK_TAGS_DEFAULT_ONLY = {"turnGravityOff": "false", "gravity": "true", "selfCollide": "false"}
+# Tags read by Gazebo's URDF import that have no Bullet counterpart here: one warning per tag and model.
+LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", "maxContacts", "dampingFactor",
+                       "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
+                       "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
+                       "preserveFixedJoint", "disableFixedJointLumping")
+# A negligible inertial for massless lumped links: PyBullet adds it to the parent, which leaves the
+# parent's mass and inertia unchanged to within rounding, as Gazebo's lumping does.
+_NEGLIGIBLE_MASS = 1e-9
+_NEGLIGIBLE_INERTIA = 1e-12
+# Shapes no larger than the farthest a model may be placed (engine.MAX_POSITION, m).
+_MAX_SHAPE_SIZE = 1e5
+_SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
+# kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
+_MAX_MASS = 1e9
+_MAX_INERTIA = 1e9
+
+
+@dataclass
+class Link:
+    name: str
+    has_inertial: bool
+    mass: float
+    collision_kinds: List[str]
+    # Radius of each collision shape that has one (cylinder, sphere), else None; in collision_kinds' order.
+    collision_radii: List[Optional[float]] = field(default_factory=list)
+    gazebo: List[ElementTree.Element] = field(default_factory=list)
+
+    def gazebo_tag(self, tag: str) -> Optional[str]:
+        """Text of the last ``<gazebo reference>`` child with this tag (later blocks win, as in sdformat)."""
+        text = None
+        for block in self.gazebo:
+            child = block.find(tag)
+            if child is not None and child.text is not None:
+                text = child.text.strip()
+        return text
+
+
+@dataclass
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: Pose
+    axis: Tuple[float, float, float]
+    # URDF <limit>: lower/upper (rad or m; -inf/inf when absent or continuous), effort and velocity (0 = none given)
+    lower: float = -math.inf
+    upper: float = math.inf
+    effort: float = 0.0
+    velocity: float = 0.0
+    has_limit: bool = False  # a <limit> element was given
+    # <safety_controller>: (soft_lower_limit, soft_upper_limit, k_position, k_velocity)
+    safety: Optional[Tuple[float, float, float, float]] = None
+    mimic: Optional[Tuple[str, float, float]] = None  # <mimic>: (leader joint, multiplier, offset)
+
+    @property
+    def movable(self) -> bool:
+        return self.type in MOVABLE_JOINT_TYPES
+
+
+@dataclass
+class RobotModel:
+    name: str
+    root: str
+    links: Dict[str, Link]
+    joints: Dict[str, Joint]
+    plugins: List[ElementTree.Element]
+    # For every URDF link: (the simulated link it is lumped into, its pose in that link's frame).
+    lumped_into: Dict[str, Tuple[str, Pose]]
+    pybullet_urdf: str
+    transmissions: List[ElementTree.Element]
+    document: XmlDocument  # the parsed robot_description: line numbers for messages
+
+    @property
+    def anchored(self) -> bool:
+        """Whether the root link is URDF's ``world``: Gazebo fixes the model to the world there, as arm
+        descriptions mount their base with a fixed ``world_joint``."""
+        return self.root == "world"
+
+    def movable_joints(self) -> List[Joint]:
+        return [joint for joint in self.joints.values() if joint.movable]
+
+    def collision_names(self) -> Dict[str, List[str]]:
+        """Simulated link -> the names sdformat gives the collisions it holds: "L_collision" (then
+        "L_collision_1", ...) for link L's own, "P_fixed_joint_lump__L_collision" for those lumped into P."""
+        return {holder: [name for name, _, _ in boxes] for holder, boxes in self.collision_boxes().items()}
+
+    def collision_boxes(self) -> Dict[str, List[Tuple[str, Pose, Tuple[float, float, float]]]]:
+        """Simulated link -> (sdformat's name, pose in that link's frame, half extents) of each collision it
+        holds; a mesh's extents are unknown here and taken as zero (its origin stands for it)."""
+        boxes: Dict[str, List[Tuple[str, Pose, Tuple[float, float, float]]]] = {}
+        elements = {element.get("name"): element for element in self.document.root.findall("link")}
+        for link in self.links.values():
+            if link.name not in self.lumped_into or link.name not in elements:
+                continue
+            holder, offset = self.lumped_into[link.name]
+            prefix = link.name if holder == link.name else f"{holder}_fixed_joint_lump__{link.name}"
+            for index, collision in enumerate(elements[link.name].findall("collision")):
+                name = f"{prefix}_collision" + (f"_{index}" if index else "")
+                pose = compose(offset, read_origin(collision, self.document))
+                boxes.setdefault(holder, []).append((name, pose, _half_extents(collision.find("geometry"))))
+        return boxes
+
+    def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
+        """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
+        return [(link.name, sensor) for link in self.links.values()
+                for block in link.gazebo for sensor in block.findall("sensor")]
+
+    def caster_links(self, driven_joints) -> List[str]:
+        """Links that act as ball casters: every collision a sphere, on a joint nothing drives.
+
+        Gazebo users rely on ODE letting such a sphere slide sideways. In Bullet, a sphere on a one-axis
+        joint (the course's back caster) rolls only forwards and its sideways friction pins the robot when
+        it turns in place, so these links get frictionless contacts unless their <gazebo> block sets mu1/mu2.
+        """
+        casters = []
+        for joint in self.joints.values():
+            link = self.links[joint.child]
+            if (joint.name not in driven_joints and link.collision_kinds
+                    and all(kind == "sphere" for kind in link.collision_kinds)
+                    and link.gazebo_tag("mu1") is None and link.gazebo_tag("mu2") is None):
+                casters.append(link.name)
+        return casters
+
+
+def _parse_document(urdf_xml: str, source: str) -> XmlDocument:
+    if not urdf_xml or not urdf_xml.strip():
+        raise ModelError(f"{source} is empty")
+    document = parse_xml(urdf_xml.encode(), source, ModelError)
+    if document.root.tag != "robot":
+        raise ModelError(f"{source} is not URDF: its root element is <{document.root.tag}>, not <robot>")
+    return document
+
+
+def _safety_controller(element: ElementTree.Element, where: str,
+                       document: XmlDocument) -> Optional[Tuple[float, float, float, float]]:
+    """URDF <safety_controller> (urdfdom: k_velocity required, the others 0 when absent), or None."""
+    safety = element.find("safety_controller")
+    if safety is None:
+        return None
+    if safety.get("k_velocity") is None:
+        raise ModelError(f"{where}: <safety_controller> needs k_velocity")
+    return tuple(read_attribute_numbers(safety, name, document, (0.0,), 1)[0]
+                 for name in ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"))
+
+
+def _mimic(element: ElementTree.Element, where: str, document: XmlDocument) -> Optional[Tuple[str, float, float]]:
+    """URDF <mimic joint= multiplier= offset=> (multiplier 1 and offset 0 when absent), or None."""
+    mimic = element.find("mimic")
+    if mimic is None:
+        return None
+    if not mimic.get("joint"):
+        raise ModelError(f"{where}: <mimic> needs a joint")
+    multiplier = read_attribute_numbers(mimic, "multiplier", document, (1.0,), 1)[0]
+    offset = read_attribute_numbers(mimic, "offset", document, (0.0,), 1)[0]
+    return mimic.get("joint"), multiplier, offset
+
+
+def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDocument) -> dict:
+    limit = element.find("limit")
+    if limit is None:
+        return {}
+    lower, upper, effort, velocity = (read_attribute_numbers(limit, name, document, (default,), 1)[0]
+                                      for name, default in (("lower", 0.0), ("upper", 0.0), ("effort", 0.0),
+                                                            ("velocity", 0.0)))
+    values = {"effort": effort, "velocity": velocity, "has_limit": True}
+    if joint_type != "continuous":
+        values.update(lower=lower, upper=upper)
+    return values
+
+
+def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
+    """Parse and check a URDF string; ``source`` names it in every error ("robot_description", a file)."""
+    document = _parse_document(urdf_xml, source)
+    root = document.root
+    name = root.get("name") or "robot"
+    links: Dict[str, Link] = {}
+    for element in root.findall("link"):
+        link_name = element.get("name")
+        if not link_name:
+            raise ModelError(f"{source}: a <link> has no name")
+        if link_name in links:
+            raise ModelError(f"{source}: link '{link_name}' is defined twice")
+        inertial = element.find("inertial")
+        mass = 0.0
+        if inertial is not None and inertial.find("mass") is not None:
+            mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
+            try:
+                check_range(mass, 0.0, _MAX_MASS)
+            except ValueError as error:
+                raise ModelError(f"{source}: link '{link_name}': <mass value>: {error}") from None
+        kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
+                 if geometry is not None and len(geometry)]
+        links[link_name] = Link(link_name, inertial is not None and mass > 0, mass, kinds)
+    if not links:
+        raise ModelError(f"{source}: the robot has no <link>")
+
+    joints: Dict[str, Joint] = {}
+    for element in root.findall("joint"):
+        joint_name = element.get("name")
+        if not joint_name:
+            raise ModelError(f"{source}: a <joint> has no name")
+        where = f"{source} joint '{joint_name}'"
+        if joint_name in joints:
+            raise ModelError(f"{where}: defined twice")
+        joint_type = element.get("type")
+        if joint_type not in SUPPORTED_JOINT_TYPES:
+            raise ModelError(f"{where}: type '{joint_type}' is not supported; use one of "
+                             f"{', '.join(SUPPORTED_JOINT_TYPES)}")
+        parent, child = element.find("parent"), element.find("child")
+        if parent is None or child is None:
+            raise ModelError(f"{where}: needs <parent link> and <child link>")
+        for role, link_name in (("parent", parent.get("link")), ("child", child.get("link"))):
+            if link_name not in links:
+                raise ModelError(f"{where}: {role} link '{link_name}' is not defined")
+        # URDF allows one parent; PyBullet would keep one of two silently (and crash on a duplicate joint).
+        other = next((j.name for j in joints.values() if j.child == child.get("link")), None)
+        if other is not None:
+            raise ModelError(f"{where}: child link '{child.get('link')}' already has a parent joint, '{other}'")
+        axis = element.find("axis")
+        joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
+                                   read_origin(element, document),
+                                   read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
+                                   if axis is not None else (1.0, 0.0, 0.0),
+                                   safety=_safety_controller(element, where, document),
+                                   mimic=_mimic(element, where, document),
+                                   **_joint_limits(element, joint_type, document))
+
+    for joint in joints.values():
+        if joint.mimic is not None and (joint.mimic[0] not in joints or not joints[joint.mimic[0]].movable
+                                        or not joint.movable):
+            raise ModelError(f"{source} joint '{joint.name}': <mimic joint='{joint.mimic[0]}'> needs a movable joint "
+                             f"mimicking a movable joint of the robot")
+    children = {joint.child for joint in joints.values()}
+    roots = [link_name for link_name in links if link_name not in children]
+    if len(roots) != 1:
+        raise ModelError(f"{source}: expected one root link, found {', '.join(roots) or 'none (a loop)'}")
+    unreachable = set(links) - set(_subtree(roots[0], joints))
+    if unreachable:
+        raise ModelError(f"{source}: links {', '.join(sorted(unreachable))} form a loop, not reachable "
+                         f"from root link '{roots[0]}'")
+
+    plugins = _collect_gazebo_blocks(root, links, joints, source)
+    transmissions = root.findall("transmission")
+    dropped = _drop_massless_moving_links(links, joints, source)
+    lumped_into = _lump_fixed_links(roots[0], links, joints)
+    pybullet_urdf = _pybullet_urdf(root, links, dropped, document, source)
+    _read_collision_radii(root, links, document)
+    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, pybullet_urdf, transmissions, document)
+
+
+def _read_collision_radii(root: ElementTree.Element, links: Dict[str, Link], document: XmlDocument):
+    """Each link's collision radii (a wheel's, for diff_drive_controller), once the shapes have been checked."""
+    for element in root.findall("link"):
+        link = links.get(element.get("name"))
+        if link is None:  # dropped as a massless moving link
+            continue
+        shapes = [geometry[0] for geometry in (c.find("geometry") for c in element.findall("collision"))
+                  if geometry is not None and len(geometry)]
+        link.collision_radii = [
+            read_attribute_numbers(shape, "radius", document, (0.0,), 1)[0] if shape.get("radius") is not None
+            else None for shape in shapes]
+
+
+def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Element]:
+    plugins = []
+    for block in root.findall("gazebo"):
+        reference = block.get("reference")
+        if reference is None:
+            for child in block:
+                if child.tag == "plugin":
+                    plugins.append(child)
+                elif child.tag != "static":
+                    warn_once(_logger, f"{source}: model-level <gazebo> tag <{child.tag}> is not supported; ignored")
+            continue
+        if reference in links:
+            links[reference].gazebo.append(block)
+            for child in block:
+                _check_link_tag(child, reference, source)
+        elif reference not in joints:
+            warn_once(_logger, f"{source}: <gazebo reference='{reference}'> names no link or joint; ignored")
+    return plugins
+
+
+def _check_link_tag(child: ElementTree.Element, reference: str, source: str):
+    """Say once per tag and model what a <gazebo reference> tag that the bridge does not act on means."""
+    where = f"{source}: <gazebo reference='{reference}'> <{child.tag}>"
+    if child.tag in LINK_TAGS_USED:
+        return
+    if child.tag in LINK_TAGS_DEFAULT_ONLY:
+        if (child.text or "").strip().lower() not in (LINK_TAGS_DEFAULT_ONLY[child.tag],
+                                                      "0" if LINK_TAGS_DEFAULT_ONLY[child.tag] == "false" else "1"):
+            warn_once(_logger, f"{where}{(child.text or '').strip()}</{child.tag}> is not simulated; "
+                               "Gazebo's default applies")
+    elif child.tag in LINK_TAGS_NO_EFFECT:
+        warn_once(_logger, f"{where} has no Bullet counterpart; ignored")
+    else:
+        warn_once(_logger, f"{where} is not supported; ignored")
+
+
+def _subtree(link_name, joints) -> List[str]:
+    """``link_name`` and every link below it. It ends on any input: with one parent per link (checked by
+    parse_robot) a loop cannot hang below the root."""
+    names = [link_name]
+    pending = [link_name]
+    while pending:
+        parent = pending.pop()
+        children = [joint.child for joint in joints.values() if joint.parent == parent]
+        names.extend(children)
+        pending.extend(children)
+    return names
+
+
+def _drop_massless_moving_links(links, joints, source) -> List[str]:
+    """Gazebo does not model a massless link on a moving joint; it drops it with its whole subtree."""
+    dropped: List[str] = []
+    for joint in list(joints.values()):
+        if joint.name not in joints or not joint.movable or links[joint.child].has_inertial:
+            continue
+        subtree = _subtree(joint.child, joints)
+        warn_once(_logger, f"{source}: link '{joint.child}' has no <inertial> but moves on joint '{joint.name}'; like "
+                           f"Gazebo, the simulation leaves out it and its subtree ({', '.join(subtree)})")
+        dropped.extend(subtree)
+        for name in subtree:
+            del links[name]
+        for other in [j for j in joints.values() if j.child in subtree]:
+            del joints[other.name]
+    return dropped
+
+
+def _lump_fixed_links(root_name, links, joints) -> Dict[str, Tuple[str, Pose]]:
+    lumped = {root_name: (root_name, IDENTITY)}
+    pending = [root_name]
+    while pending:
+        parent = pending.pop()
+        body, offset = lumped[parent]
+        for joint in joints.values():
+            if joint.parent != parent:
+                continue
+            if joint.type == "fixed":
+                lumped[joint.child] = (body, compose(offset, joint.origin))
+            else:
+                lumped[joint.child] = (joint.child, IDENTITY)
+            pending.append(joint.child)
+    return lumped
+
+
+def _mesh_problem(filename: str) -> Optional[str]:
+    """Why PyBullet could not read a URDF mesh file, or None. Nothing is opened: a FIFO would block the loader."""
+    path = filename[len("file://"):] if filename.startswith("file://") else filename
+    if "://" in path:
+        return "only absolute paths, file:// and package:// (resolved by spawn_urdf_model) can be read"
+    if not os.path.isabs(path):
+        return "a relative path has nothing to be relative to in robot_description; use package:// or an absolute path"
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as error:
+        return error.strerror or str(error)
+    if not stat.S_ISREG(mode):
+        return "not a regular file"
+    if not os.access(path, os.R_OK):
+        return "not readable"
+    return None
+
+
+def _shape_problem(element: ElementTree.Element) -> Optional[str]:
+    """Why PyBullet could not build the shape of a <visual> or <collision>, or None. PyBullet refuses the whole
+    URDF for it without saying where ("Cannot load URDF file"), or builds a shape from NaN."""
+    geometry = element.find("geometry")
+    shapes = [] if geometry is None else list(geometry)
+    if len(shapes) != 1:
+        found = ", ".join(f"<{shape.tag}>" for shape in shapes) or "none"
+        return f"<geometry> needs one shape (box, cylinder, sphere or mesh), found {found}"
+    shape = shapes[0]
+    if shape.tag == "mesh":
+        problem = _mesh_problem(shape.get("filename", ""))
+        if problem is not None:
+            return f"mesh '{shape.get('filename', '')}': {problem}"
+        return _numbers_problem(shape, "scale", 3, optional=True, minimum=None)
+    if shape.tag not in _SHAPE_SIZES:
+        return f"<{shape.tag}> is not a URDF shape (box, cylinder, sphere or mesh)"
+    for attribute, count in _SHAPE_SIZES[shape.tag]:
+        problem = _numbers_problem(shape, attribute, count, optional=False, minimum=0.0)
+        if problem is not None:
+            return problem
+    return None
+
+
+def _numbers_problem(shape: ElementTree.Element, attribute: str, count: int, optional: bool,
+                     minimum: Optional[float]) -> Optional[str]:
+    text = shape.get(attribute)
+    if text is None:
+        return None if optional else f"<{shape.tag}> needs {attribute}"
+    try:
+        for value in parse_floats(text, count):
+            check_range(abs(value) if minimum is None else value, minimum or 0.0, _MAX_SHAPE_SIZE,
+                        exclusive_minimum=True)
+    except ValueError as error:
+        return f"<{shape.tag} {attribute}>: {error}"
+    return None
+
+
+def _check_links(root: ElementTree.Element, copied: ElementTree.Element, document: XmlDocument, source: str):
+    """Shapes, origins and inertials PyBullet could not load or that would make NaN. A bad collision refuses the
+    model; a bad visual is left out of ``copied`` (the URDF PyBullet gets) with a warning: the simulation does
+    not need it, and PyBullet would refuse the whole URDF for it."""
+    for link, copied_link in zip(root.findall("link"), copied.findall("link")):
+        _check_inertial(link.find("inertial"), document, f"{source}: link '{link.get('name')}'")
+        for kind in ("collision", "visual"):
+            for element, copied_element in zip(link.findall(kind), copied_link.findall(kind)):
+                read_origin(element, document)
+                problem = _shape_problem(element)
+                if problem is None:
+                    continue
+                message = f"{source}: link '{link.get('name')}' {kind} {problem}"
+                if kind == "collision":
+                    raise ModelError(message)
+                warn_once(_logger, message + "; the visual is left out")
+                copied_link.remove(copied_element)
+
+
+def _check_inertial(inertial: Optional[ElementTree.Element], document: XmlDocument, where: str):
+    if inertial is None:
+        return
+    read_origin(inertial, document)
+    inertia = inertial.find("inertia")
+    if inertia is None:
+        return
+    for name in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"):
+        value = read_attribute_numbers(inertia, name, document, (0.0,), 1)[0]
+        try:
+            check_range(value if name in ("ixx", "iyy", "izz") else abs(value), 0.0, _MAX_INERTIA)
+        except ValueError as error:
+            raise ModelError(f"{where}: <inertia {name}>: {error}") from None
+
+
+def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], document: XmlDocument,
+                   source: str) -> str:
+    """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless,
+    shapes, origins and inertials checked."""
+    original, root = root, copy.deepcopy(root)
+    _check_links(original, root, document, source)
+    for element in list(root):
+        if element.tag in ("gazebo", "transmission"):
+            root.remove(element)
+        elif element.tag == "link" and element.get("name") in dropped:
+            root.remove(element)
+        elif element.tag == "joint" and element.find("child").get("link") in dropped:
+            root.remove(element)
+    for element in root.findall("link"):
+        if links[element.get("name")].has_inertial:
+            continue
+        for stale in element.findall("inertial"):
+            element.remove(stale)
+        inertial = ElementTree.SubElement(element, "inertial")
+        ElementTree.SubElement(inertial, "mass", value=repr(_NEGLIGIBLE_MASS))
+        ElementTree.SubElement(inertial, "inertia", ixx=repr(_NEGLIGIBLE_INERTIA), iyy=repr(_NEGLIGIBLE_INERTIA),
+                               izz=repr(_NEGLIGIBLE_INERTIA), ixy="0", ixz="0", iyz="0")
+    return ElementTree.tostring(root, encoding="unicode")
+
+
+def _half_extents(geometry: Optional[ElementTree.Element]) -> Tuple[float, float, float]:
+    """Half the size of a checked URDF shape along its own axes (a mesh: zero, its size is not read here)."""
+    shape = geometry[0] if geometry is not None and len(geometry) else None
+    if shape is None or shape.tag == "mesh":
+        return (0.0, 0.0, 0.0)
+    if shape.tag == "box":
+        return tuple(value / 2.0 for value in parse_floats(shape.get("size", "0 0 0"), 3))
+    radius = float(shape.get("radius", "0"))
+    if shape.tag == "cylinder":
+        return (radius, radius, float(shape.get("length", "0")) / 2.0)
+    return (radius, radius, radius)
