@@ -22,10 +22,8 @@ ROVER_XACRO = os.path.join(WORKSPACE_SRC, "rover_description", "urdf", "rover.ur
 ROVER_CONTROL = os.path.join(WORKSPACE_SRC, "rover_control", "config", "control.yaml")
 # An ASCII STL block, 1 x 0.5 x 0.25 m: PyBullet's URDF importer reads only binary STL.
 ASCII_BLOCK = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "worlds", "meshes", "block.stl"))
-# The world's default contact_surface_layer: contacts rest that deep.
-SURFACE_LAYER = 0.001
 # Both Husky-sized bases rest with base_link at the wheel radius minus the axles' offset above it.
-HUSKY_REST_HEIGHT = 0.1651 - 0.03282 - SURFACE_LAYER
+HUSKY_REST_HEIGHT = 0.1651 - 0.03282
 # SDF's <surface><contact><ode><max_vel>, which caps the correction's velocity below the world's default 100 m/s.
 SURFACE_MAX_VEL = 0.01
 
@@ -132,8 +130,8 @@ def test_a_robot_block_spawned_half_into_the_floor_ends_resting_on_it(tmp_path, 
         heights = [position[2] for position in positions]
         print(f"figure: URDF block ({geometry.split()[0][1:]}) spawned half into the floor: ends at "
               f"{heights[-1]:.4f} m (0.125 on the floor), lowest {min(heights):.4f}, fastest {max(speeds):.4f} m/s")
-        # The box rests the surface layer deep; Bullet keeps a convex mesh a 1 mm margin out, back to 0.125.
-        assert heights[-1] == pytest.approx(0.125 - SURFACE_LAYER, abs=0.0012)
+        # Bullet keeps a convex mesh a 1 mm margin out.
+        assert heights[-1] == pytest.approx(0.125, abs=0.0012)
         assert settled_at(heights, heights[-1], sim.step_size, tolerance=0.001) <= 0.2
         assert min(heights) >= 0.0
     finally:
@@ -146,7 +144,7 @@ def test_an_sdf_block_spawned_half_into_the_floor_ends_resting_on_it(tmp_path, g
     sim = Simulation(world(tmp_path, model("block", geometry=geometry)), CORE_PLUGINS)
     try:
         positions, speeds = record(sim, "block", 1.0)
-        assert positions[-1][2] == pytest.approx(0.125 - SURFACE_LAYER, abs=0.0012)
+        assert positions[-1][2] == pytest.approx(0.125, abs=0.0012)
         assert min(position[2] for position in positions) >= 0.0
         assert max(speeds) <= SURFACE_MAX_VEL * 1.001
     finally:
@@ -162,7 +160,7 @@ def test_two_1_m_boxes_spawned_overlapping_by_0_3_m_separate_slowly(tmp_path):
         fastest = max(left_speeds + right_speeds)
         print(f"figure: two 1 m boxes spawned 0.3 m into each other: {gap:.4f} m apart after 1.5 s, fastest "
               f"{fastest:.4f} m/s, moved {-left[-1][0]:.3f} and {right[-1][0] - 0.7:.3f} m")
-        assert gap == pytest.approx(1.0 - SURFACE_LAYER, abs=0.001)
+        assert gap == pytest.approx(1.0, abs=0.001)
         assert fastest < 1.0
         # Each is pushed about its share of the overlap, and neither slides on.
         assert 0.1 < -left[-1][0] < 0.2 and 0.1 < right[-1][0] - 0.7 < 0.2
@@ -183,7 +181,7 @@ def test_a_base_spawned_into_a_wall_comes_out_beside_it(tmp_path):
         print(f"figure: Husky-sized base spawned 0.19 m into a wall: its front ends {0.3 - front:.4f} m before the "
               f"wall, fastest {max(speeds):.4f} m/s, at height {positions[-1][2]:.4f} m")
         # Out, then rolling back on its free wheels at no more than the cap.
-        assert 0.3 - SURFACE_MAX_VEL * 1.0 <= front <= 0.3 + SURFACE_LAYER
+        assert 0.3 - SURFACE_MAX_VEL * 1.0 <= front <= 0.3 + 0.0001
         assert max(speeds) <= SURFACE_MAX_VEL * 1.05
         assert positions[-1][2] == pytest.approx(HUSKY_REST_HEIGHT, abs=0.005)
     finally:
@@ -227,3 +225,15 @@ def test_a_bad_constraint_is_refused_naming_it(tmp_path, tag, value):
 def test_a_cfm_says_once_that_it_is_not_applied(tmp_path, caplog):
     world(tmp_path, constraints="<ode><constraints><cfm>0.001</cfm></constraints></ode>")
     assert caplog.text.count("<cfm> is not applied") == 1
+
+
+def test_a_box_wedged_between_two_walls_stays_slow_and_is_said_once(tmp_path, caplog):
+    # A slab 0.8 m above the floor: the 1 m box cannot get out but by sliding 2 m sideways.
+    slab = model("slab", z=0.9, geometry="<box><size>4 4 0.2</size></box>", static=True)
+    sim = Simulation(world(tmp_path, slab, model("wedged", z=0.5)), CORE_PLUGINS)
+    try:
+        _, speeds = record(sim, "wedged", 1.01)
+        assert max(speeds) <= SURFACE_MAX_VEL * 1.001
+        assert caplog.text.count("model 'wedged' is still inside another model 1 s after it was placed") == 1
+    finally:
+        sim.close()

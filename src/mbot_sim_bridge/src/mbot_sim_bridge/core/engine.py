@@ -36,10 +36,13 @@ DEFAULT_MU = 1.0
 # SDF's <surface><contact><ode><max_vel> when a link sets none (URDF <maxVel>): with the world's
 # contact_max_correcting_vel, the most velocity Gazebo's ODE leaves a link with from undoing a penetration.
 DEFAULT_SURFACE_MAX_VEL = 0.01  # m/s
-# A placed body settles until it has gone this long without a contact deeper than the surface layer (plus
-# PENETRATION_TOLERANCE); one still that deep after SETTLING_LIMIT is left to Bullet's contacts, with a warning.
+# PyBullet's contact slop: the depth its contacts leave uncorrected (ODE's surface layer, 1 mm by default, is not
+# applied: see _configure).
+CONTACT_SLOP = 1.0e-5  # m
+# A placed body settles until it has gone this long without a contact deeper than the slop (plus
+# PENETRATION_TOLERANCE); one still that deep after SETTLING_WARNING is said once (it stays watched).
 SETTLED_AFTER = 0.01  # s of sim time
-SETTLING_LIMIT = 1.0  # s of sim time
+SETTLING_WARNING = 1.0  # s of sim time
 PENETRATION_TOLERANCE = 1.0e-5  # m
 
 
@@ -284,10 +287,11 @@ class Engine:
         # friction made four-wheel skid-steer bases turn in place by fits and starts (yaw rate 0.08 to 0.8 rad/s
         # for a steady 0.8 command).
         self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1, enableConeFriction=0)
-        # The world's <ode><constraints>: the surface layer is the depth contacts leave uncorrected (Bullet's
-        # contact slop, 0.01 mm in PyBullet), erp ODE's error reduction for joints (Bullet's erp; the SDF default is
-        # PyBullet's). Contacts keep PyBullet's contactERP (0.08): ODE's take theirs from the surfaces' kp and kd.
-        self.client.setPhysicsEngineParameter(contactSlop=self.physics.contact_surface_layer, erp=self.physics.erp)
+        # The world's <ode><constraints> erp is ODE's error reduction for joints, Bullet's erp (the SDF default is
+        # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
+        # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
+        # into what it touches and moved the skid-steer turn figures by 1 %.
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, erp=self.physics.erp)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -442,13 +446,16 @@ class Engine:
         rate, but leave it with a separating velocity of at most min(link max_vel, contact_max_correcting_vel)
         (ODE solves the correction apart from the velocity). Bullet's multibody contacts turn the whole correction
         into velocity (its split impulse is for rigid bodies only), which threw a robot spawned 13 cm into the
-        ground 4.6 m up. So after each step, where a contact of a placed body is deeper than the surface layer,
-        the twists of the bodies in it are scaled so that their separating speed there is at most the cap.
+        ground 4.6 m up. So after each step, where a contact of a placed body is deeper than the slop,
+        the velocities of the bodies in it are scaled so that they move apart there at no more than the cap (the
+        whole relative speed, not only its normal part: through friction and rotation the correction also
+        pushes sideways, which carried a box wedged between two walls off at 1 m/s).
 
         Bodies are watched from their placement until they have been clear of deep contacts for SETTLED_AFTER:
-        contacts that arise in motion keep Bullet's behaviour (and its cost), as before."""
+        contacts that arise in motion keep Bullet's behaviour (and its cost), as before. A wedged body stays
+        watched, as ODE caps its contacts for ever."""
         client, physics = self.client, self.physics
-        deep = physics.contact_surface_layer + PENETRATION_TOLERANCE
+        deep = CONTACT_SLOP + PENETRATION_TOLERANCE
         cap = min(physics.contact_max_correcting_vel, DEFAULT_SURFACE_MAX_VEL)
         settled_after = max(1, round(SETTLED_AFTER / physics.max_step_size))
         scales: Dict[int, float] = {}
@@ -462,17 +469,16 @@ class Engine:
                 body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
                 velocity_a = self._point_velocity(body_a, link_a, on_a)
                 velocity_b = self._point_velocity(body_b, link_b, on_b)
-                separating = sum(n * (a - b) for n, a, b in zip(normal_on_b, velocity_a, velocity_b))
-                if separating > cap:
+                speed = math.dist(velocity_a, velocity_b)
+                if speed > cap:
                     for moved in (body_a, body_b):
-                        scales[moved] = min(scales.get(moved, 1.0), cap / separating)
+                        scales[moved] = min(scales.get(moved, 1.0), cap / speed)
             if counts[1] >= settled_after:
                 del self._settling[body]
-            elif counts[0] * physics.max_step_size >= SETTLING_LIMIT:
-                del self._settling[body]
-                warn_once(_logger, f"model '{self._name_of(body)}' is still inside another model {SETTLING_LIMIT:g} s "
-                                   "after it was placed; from now on Bullet's contacts push it out without a bound "
-                                   "on its velocity")
+            elif counts[0] == round(SETTLING_WARNING / physics.max_step_size):
+                warn_once(_logger, f"model '{self._name_of(body)}' is still inside another model "
+                                   f"{SETTLING_WARNING:g} s after it was placed (wedged?); it is pushed out at "
+                                   f"{cap:g} m/s at most")
         if scales:
             self._scale_velocities(scales)
 

@@ -38,8 +38,8 @@ _BUILTIN_MODELS = {
 }
 BUILTIN_MODEL_NAMES = tuple(_BUILTIN_MODELS)
 
-# <physics><ode><constraints> read, each with the largest value accepted: erp is a fraction, and a surface layer
-# or correcting velocity beyond these would sink bodies into one another or throw them.
+# <physics><ode><constraints> read, each with the largest value accepted: erp is a fraction; beyond these a
+# correcting velocity would throw bodies and a surface layer sink them (in Gazebo, and in a saved world).
 _CONSTRAINT_LIMITS = {"erp": 1.0, "contact_max_correcting_vel": 1.0e4, "contact_surface_layer": 0.1}
 # Children read elsewhere or without effect on contacts pass silently; unsupported and unknown ones warn once.
 _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "gui", "physics", "scene", "light",
