@@ -4,12 +4,13 @@ being thrown, mesh and primitive bodies spawned half into the floor end on it, a
 separate without flying apart."""
 import math
 import os
+import pathlib
 
 import pytest
 import xacro_noetic as xacro
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, simulate
 
-from mbot_sim_bridge.core.errors import WorldError
+from mbot_sim_bridge.core.errors import ModelError, WorldError
 from mbot_sim_bridge.core.geometry import IDENTITY, Pose
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.robot_model import parse_robot
@@ -134,6 +135,23 @@ def test_a_robot_block_spawned_half_into_the_floor_ends_resting_on_it(tmp_path, 
         assert heights[-1] == pytest.approx(0.125, abs=0.0012)
         assert settled_at(heights, heights[-1], sim.step_size, tolerance=0.001) <= 0.2
         assert min(heights) >= 0.0
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("text, problem", [
+    ("solid x\n  facet normal 0 0 1\n", "mesh has no triangles"),
+    (pathlib.Path(ASCII_BLOCK).read_text().replace("-0.5", "nan", 1), "non-finite"),
+], ids=["no_triangles", "nan_vertex"])
+def test_an_ascii_stl_pybullet_would_get_unreadable_refuses_the_spawn_naming_the_file(tmp_path, text, problem):
+    path = tmp_path / "bad.stl"
+    path.write_text(text)
+    sim = Simulation(world(tmp_path), CORE_PLUGINS)
+    try:
+        with pytest.raises(ModelError, match=f"{path}: .*{problem}"):
+            sim.spawn_robot(parse_robot(BOX_ROBOT.format(name="bad", geometry=f'<mesh filename="{path}"/>'),
+                                        "model 'bad'"), "bad")
+        assert sim.model_names() == ["ground_plane"]
     finally:
         sim.close()
 
