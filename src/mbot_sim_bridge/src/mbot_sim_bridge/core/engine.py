@@ -36,11 +36,13 @@ DEFAULT_MU = 1.0
 # SDF's <surface><contact><ode><max_vel> when a link sets none (URDF <maxVel>): with the world's
 # contact_max_correcting_vel, the most velocity Gazebo's ODE leaves a link with from undoing a penetration.
 DEFAULT_SURFACE_MAX_VEL = 0.01  # m/s
-# PyBullet's contact slop: the depth its contacts leave uncorrected (ODE's surface layer, 1 mm by default, is not
-# applied: see _configure).
+# PyBullet's contact slop and error reduction, kept: its contacts leave this depth uncorrected (ODE's surface
+# layer, 1 mm by default, is not applied: see _configure) and undo this fraction of the rest per step.
 CONTACT_SLOP = 1.0e-5  # m
-# A placed body settles until it has gone this long without a contact deeper than the slop (plus
-# PENETRATION_TOLERANCE); one still that deep after SETTLING_WARNING is said once (it stays watched).
+CONTACT_ERP = 0.08
+# A placed body settles until it has gone this long without a contact deep enough for Bullet to undo it faster
+# than the cap (at least PENETRATION_TOLERANCE beyond the slop); one still that deep after SETTLING_WARNING is said
+# once (it stays watched).
 SETTLED_AFTER = 0.01  # s of sim time
 SETTLING_WARNING = 1.0  # s of sim time
 PENETRATION_TOLERANCE = 1.0e-5  # m
@@ -291,7 +293,7 @@ class Engine:
         # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
         # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
         # into what it touches and moved the skid-steer turn figures by 1 %.
-        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, erp=self.physics.erp)
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -446,17 +448,18 @@ class Engine:
         rate, but leave it with a separating velocity of at most min(link max_vel, contact_max_correcting_vel)
         (ODE solves the correction apart from the velocity). Bullet's multibody contacts turn the whole correction
         into velocity (its split impulse is for rigid bodies only), which threw a robot spawned 13 cm into the
-        ground 4.6 m up. So after each step, where a contact of a placed body is deeper than the slop,
-        the velocities of the bodies in it are scaled so that they move apart there at no more than the cap (the
-        whole relative speed, not only its normal part: through friction and rotation the correction also
-        pushes sideways, which carried a box wedged between two walls off at 1 m/s).
+        ground 4.6 m up. So after each step, where a contact of a placed body is deep enough for Bullet to undo it
+        faster than the cap (resting contacts are not), the velocities of the bodies in it are scaled so that they
+        move apart there at no more than the cap (the whole relative speed, not only its normal part: through
+        friction and rotation the correction also pushes sideways, which carried a box wedged between two walls
+        off at 1 m/s).
 
         Bodies are watched from their placement until they have been clear of deep contacts for SETTLED_AFTER:
         contacts that arise in motion keep Bullet's behaviour (and its cost), as before. A wedged body stays
         watched, as ODE caps its contacts for ever."""
         client, physics = self.client, self.physics
-        deep = CONTACT_SLOP + PENETRATION_TOLERANCE
         cap = min(physics.contact_max_correcting_vel, DEFAULT_SURFACE_MAX_VEL)
+        deep = CONTACT_SLOP + max(PENETRATION_TOLERANCE, cap * physics.max_step_size / CONTACT_ERP)
         settled_after = max(1, round(SETTLED_AFTER / physics.max_step_size))
         scales: Dict[int, float] = {}
         for body, counts in list(self._settling.items()):
