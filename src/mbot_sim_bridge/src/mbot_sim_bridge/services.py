@@ -232,6 +232,9 @@ class GazeboRosApi:
                                                     max_update_rate=physics.real_time_update_rate,
                                                     success=True, status_message="")
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
+            ode = response.ode_config
+            ode.erp, ode.contact_max_correcting_vel = physics.erp, physics.contact_max_correcting_vel
+            ode.contact_surface_layer = physics.contact_surface_layer
             return response
         return self._guarded(GetPhysicsPropertiesResponse, get)
 

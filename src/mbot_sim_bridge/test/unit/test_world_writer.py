@@ -107,11 +107,12 @@ def test_includes_stay_includes_with_name_and_pose_and_the_rest_is_copied(tmp_pa
 
 def test_physics_settings_are_written(tmp_path):
     world = parse_world(os.path.join(REPO_WORLDS, "empty.world"))
-    world = type(world)(world.name, world.path, PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0)), world.models,
-                        world.others)
+    physics = PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0), erp=0.4, contact_max_correcting_vel=2.0,
+                            contact_surface_layer=0.002)
+    world = type(world)(world.name, world.path, physics, world.models, world.others)
     simulation = Simulation(world, {})
     _, path, reloaded = save_and_reload(simulation, world, tmp_path)
-    assert reloaded.physics == PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0))
+    assert reloaded.physics == physics
     check_sdf_1_6_structure(path)
     simulation.close()
 

@@ -19,6 +19,7 @@ from .errors import ModelError
 from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotation_matrices,
                        rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
+from .description.mesh import with_pybullet_readable_meshes
 from .description.robot_model import RobotModel
 from .description.world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
@@ -32,6 +33,19 @@ MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
+# SDF's <surface><contact><ode><max_vel> when a link sets none (URDF <maxVel>): with the world's
+# contact_max_correcting_vel, the most velocity Gazebo's ODE leaves a link with from undoing a penetration.
+DEFAULT_SURFACE_MAX_VEL = 0.01  # m/s
+# PyBullet's contact slop and error reduction, kept: its contacts leave this depth uncorrected (ODE's surface
+# layer, 1 mm by default, is not applied: see _configure) and undo this fraction of the rest per step.
+CONTACT_SLOP = 1.0e-5  # m
+CONTACT_ERP = 0.08
+# A placed body settles until it has gone this long without a contact deep enough for Bullet to undo it faster
+# than the cap (at least PENETRATION_TOLERANCE beyond the slop); one still that deep after SETTLING_WARNING is said
+# once (it stays watched).
+SETTLED_AFTER = 0.01  # s of sim time
+SETTLING_WARNING = 1.0  # s of sim time
+PENETRATION_TOLERANCE = 1.0e-5  # m
 
 
 class CachingBulletClient(BulletClient):
@@ -263,6 +277,9 @@ class Engine:
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
+        # Bodies placed where they may penetrate others (spawn, set_model_state, reset): body -> [steps settling,
+        # steps since its last deep contact]; see _bound_correction.
+        self._settling: Dict[int, List[int]] = {}
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -272,6 +289,11 @@ class Engine:
         # friction made four-wheel skid-steer bases turn in place by fits and starts (yaw rate 0.08 to 0.8 rad/s
         # for a steady 0.8 command).
         self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1, enableConeFriction=0)
+        # The world's <ode><constraints> erp is ODE's error reduction for joints, Bullet's erp (the SDF default is
+        # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
+        # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
+        # into what it touches and moved the skid-steer turn figures by 1 %.
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -287,6 +309,7 @@ class Engine:
         self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
+        self._settling.clear()
 
     @property
     def sim_time(self) -> float:
@@ -296,6 +319,13 @@ class Engine:
         """``count`` physics steps; each of ``after_each`` (recorders of per-step state, then the plugins that act
         on every step) is called after every one, with ``sim_time`` already that step's."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
+        while self._settling and count > 0:
+            step()
+            self.steps += 1
+            count -= 1
+            self._bound_correction()
+            for call in after_each:
+                call()
         if after_each:
             for _ in range(count):
                 step()
@@ -318,6 +348,7 @@ class Engine:
                                           for link, shape in zip(links, shapes)}
             self._root_from_com[body] = inverse(world.inertial_frames[name])
             self._remember_initial_state(body)
+            self._settle(body)
 
     def model_names(self) -> List[str]:
         return list(self.world_bodies) + list(self.robots)
@@ -353,6 +384,7 @@ class Engine:
                                             if names and link in robot.link_index}
         self._root_from_com[robot.body] = robot.root_from_com
         self._remember_initial_state(robot.body)
+        self._settle(robot.body, anchored=robot.model.anchored)
 
     def remove(self, name: str):
         if name in self.robots:
@@ -363,6 +395,7 @@ class Engine:
             raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
+        self._settling.pop(body, None)
         self.collision_names.pop(body, None)
         self.client.removeBody(body)
 
@@ -397,11 +430,83 @@ class Engine:
         com = compose(pose, inverse(self._root_from_com[body]))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)
+        self._settle(body)
 
     def reset_world(self):
         """Every model back to its spawn pose and joint positions, at rest (Gazebo's reset_world)."""
         for body in self._initial:
             self._restore_initial_state(body)
+            self._settle(body)
+
+    def _settle(self, body: int, anchored: bool = False):
+        """Watch a body just placed (see _bound_correction); bodies that cannot move need no watching."""
+        if not anchored and self.client.getDynamicsInfo(body, -1)[0] > 0.0:
+            self._settling[body] = [0, 0]
+
+    def _bound_correction(self):
+        """Penetration undone as Gazebo's ODE undoes it: the contacts move a body out at their error reduction
+        rate, but leave it with a separating velocity of at most min(link max_vel, contact_max_correcting_vel)
+        (ODE solves the correction apart from the velocity). Bullet's multibody contacts turn the whole correction
+        into velocity (its split impulse is for rigid bodies only), which threw a robot spawned 13 cm into the
+        ground 4.6 m up. So after each step, where a contact of a placed body is deep enough for Bullet to undo it
+        faster than the cap (resting contacts are not), the velocities of the bodies in it are scaled so that they
+        move apart there at no more than the cap (the whole relative speed, not only its normal part: through
+        friction and rotation the correction also pushes sideways, which carried a box wedged between two walls
+        off at 1 m/s).
+
+        Bodies are watched from their placement until they have been clear of deep contacts for SETTLED_AFTER:
+        contacts that arise in motion keep Bullet's behaviour (and its cost), as before. A wedged body stays
+        watched, as ODE caps its contacts for ever."""
+        client, physics = self.client, self.physics
+        cap = min(physics.contact_max_correcting_vel, DEFAULT_SURFACE_MAX_VEL)
+        deep = CONTACT_SLOP + max(PENETRATION_TOLERANCE, cap * physics.max_step_size / CONTACT_ERP)
+        settled_after = max(1, round(SETTLED_AFTER / physics.max_step_size))
+        scales: Dict[int, float] = {}
+        for body, counts in list(self._settling.items()):
+            counts[0] += 1
+            counts[1] += 1
+            for point in client.getContactPoints(bodyA=body):
+                if -point[8] <= deep:
+                    continue
+                counts[1] = 0
+                body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
+                velocity_a = self._point_velocity(body_a, link_a, on_a)
+                velocity_b = self._point_velocity(body_b, link_b, on_b)
+                speed = math.dist(velocity_a, velocity_b)
+                if speed > cap:
+                    for moved in (body_a, body_b):
+                        scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            if counts[1] >= settled_after:
+                del self._settling[body]
+            elif counts[0] == round(SETTLING_WARNING / physics.max_step_size):
+                warn_once(_logger, f"model '{self._name_of(body)}' is still inside another model "
+                                   f"{SETTLING_WARNING:g} s after it was placed (wedged?); it is pushed out at "
+                                   f"{cap:g} m/s at most")
+        if scales:
+            self._scale_velocities(scales)
+
+    def _scale_velocities(self, scales: Dict[int, float]):
+        """Each body's base twist and joint velocities times its scale: a wheel pushed out of a wall spins with the
+        correction too, and would drive the robot away."""
+        client = self.client
+        joints = {robot.body: [robot.joint_index[name] for name in robot.movable_joints]
+                  for robot in self.robots.values()}
+        for body, scale in scales.items():
+            linear, angular = client.getBaseVelocity(body)
+            client.resetBaseVelocity(body, [scale * value for value in linear], [scale * value for value in angular])
+            indices = joints.get(body)
+            if indices:
+                for index, (position, velocity, *_) in zip(indices, client.getJointStates(body, indices)):
+                    client.resetJointState(body, index, position, scale * velocity)
+
+    def _point_velocity(self, body: int, link: int, point) -> Tuple[float, ...]:
+        if link == -1:
+            return frame_velocity(self.client, body, point)[0]
+        state = self.client.getLinkState(body, link, computeLinkVelocity=1)
+        return _point_velocity(state[0], state[6], state[7], point)[0]
+
+    def _name_of(self, body: int) -> str:
+        return next(name for name in self.model_names() if self.body_of(name) == body)
 
     def robots_not_finite(self) -> List[str]:
         """The robots whose base pose the last steps made NaN or infinite. Run after every step, so kept to one
@@ -445,11 +550,16 @@ class Engine:
             self.client = None
 
     def _load_urdf(self, model: RobotModel, pose: Pose) -> int:
-        # PyBullet reads URDF only from a file; a private temp file keeps the source tree untouched.
-        handle, path = tempfile.mkstemp(prefix="mbot_sim_bridge_", suffix=".urdf")
+        # PyBullet reads URDF only from a file; a private temp folder keeps the source tree untouched and holds
+        # the binary copies of STL meshes PyBullet cannot read.
+        with tempfile.TemporaryDirectory(prefix="mbot_sim_bridge_") as folder:
+            return self._load_urdf_in(model, pose, folder)
+
+    def _load_urdf_in(self, model: RobotModel, pose: Pose, folder: str) -> int:
+        path = os.path.join(folder, "model.urdf")
+        with open(path, "w") as urdf_file:
+            urdf_file.write(with_pybullet_readable_meshes(model.pybullet_urdf, folder))
         try:
-            with os.fdopen(handle, "w") as urdf_file:
-                urdf_file.write(model.pybullet_urdf)
             flags = (pybullet.URDF_MERGE_FIXED_LINKS | pybullet.URDF_USE_INERTIA_FROM_FILE
                      | pybullet.URDF_USE_IMPLICIT_CYLINDER)
             # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
@@ -457,8 +567,6 @@ class Engine:
                 body = self.client.loadURDF(path, flags=flags, useFixedBase=model.anchored)
         except pybullet.error as error:
             raise ModelError(f"PyBullet could not load model '{model.name}': {error}") from None
-        finally:
-            os.unlink(path)
         com = compose(pose, inverse(root_from_com(self.client, body)))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         return body

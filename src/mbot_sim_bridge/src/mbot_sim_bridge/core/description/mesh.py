@@ -7,8 +7,10 @@ applies exactly. STL and OBJ carry no units and are read as metres. pycollada is
 file is read.
 """
 import os
+import struct
 import warnings
 from dataclasses import dataclass
+from xml.etree import ElementTree
 
 import numpy as np
 
@@ -46,6 +48,49 @@ def load_mesh(path: str) -> TriangleMesh:
     if not np.all(np.isfinite(corners)):
         raise ModelError(f"{path}: mesh has non-finite coordinates")
     return _welded(corners)
+
+
+def pybullet_reads_stl(path: str) -> bool:
+    """Whether PyBullet's URDF importer reads this STL: it takes only binary STL whose size matches the triangle
+    count in its header, and gives a link no collision at all for any other (an ASCII STL, which Gazebo reads)."""
+    with open(path, "rb") as stream:
+        header = stream.read(84)
+        size = os.fstat(stream.fileno()).st_size
+    return len(header) == 84 and size == 84 + 50 * struct.unpack("<I", header[80:])[0]
+
+
+def write_binary_stl(mesh: TriangleMesh, path: str):
+    corners = mesh.vertices[mesh.triangles].astype(np.float32)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
+    rows = np.zeros(len(corners), dtype=[("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+    rows["normal"], rows["corners"] = normals, corners
+    with open(path, "wb") as stream:
+        stream.write(b"binary copy for PyBullet".ljust(80, b" ") + struct.pack("<I", len(rows)))
+        stream.write(rows.tobytes())
+
+
+def with_pybullet_readable_meshes(urdf: str, folder: str) -> str:
+    """``urdf`` with each STL that PyBullet would not read (see pybullet_reads_stl) replaced by a binary copy
+    written in ``folder``; ModelError names a file that cannot be read at all."""
+    if ".stl" not in urdf.lower():
+        return urdf
+    root = ElementTree.fromstring(urdf)
+    copies = {}
+    for mesh in root.iter("mesh"):
+        path = mesh.get("filename", "")
+        path = path[len("file://"):] if path.startswith("file://") else path
+        try:
+            if not path.lower().endswith(".stl") or pybullet_reads_stl(path):
+                continue
+        except OSError as error:
+            raise ModelError(f"{path}: cannot read mesh: {error.strerror or error}") from None
+        if path not in copies:
+            copies[path] = os.path.join(folder, f"{len(copies)}.stl")
+            write_binary_stl(load_mesh(path), copies[path])
+        mesh.set("filename", copies[path])
+    return ElementTree.tostring(root, encoding="unicode") if copies else urdf
 
 
 def _welded(corners: np.ndarray) -> TriangleMesh:

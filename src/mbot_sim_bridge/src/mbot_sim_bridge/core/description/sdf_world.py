@@ -38,6 +38,9 @@ _BUILTIN_MODELS = {
 }
 BUILTIN_MODEL_NAMES = tuple(_BUILTIN_MODELS)
 
+# <physics><ode><constraints> read, each with the largest value accepted: erp is a fraction; beyond these a
+# correcting velocity would throw bodies and a surface layer sink them (in Gazebo, and in a saved world).
+_CONSTRAINT_LIMITS = {"erp": 1.0, "contact_max_correcting_vel": 1.0e4, "contact_surface_layer": 0.1}
 # Children read elsewhere or without effect on contacts pass silently; unsupported and unknown ones warn once.
 _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "gui", "physics", "scene", "light",
                   "spherical_coordinates", "state", "frame", "road"}
@@ -399,6 +402,13 @@ class _WorldParser:
                                              minimum=0.0),
                 real_time_update_rate=read_number(chosen, "real_time_update_rate", document,
                                                   defaults.real_time_update_rate, minimum=0.0))
+            constraints = chosen.find("ode/constraints")
+            for tag, maximum in _CONSTRAINT_LIMITS.items():
+                values[tag] = read_number(constraints, tag, document, getattr(defaults, tag), minimum=0.0,
+                                          maximum=maximum)
+            if read_number(constraints, "cfm", document, 0.0, minimum=0.0) != 0.0:
+                warn_once(_log, f"{document.where(constraints.find('cfm'))}: <cfm> is not applied: Bullet's global "
+                                "CFM softens contacts, where ODE's softens joints")
         # SDF 1.6 moved <gravity> from <physics> to <world>; files of either age are read.
         for parent in (world, chosen):
             if parent is not None and parent.find("gravity") is not None:

@@ -22,6 +22,11 @@ class PhysicsConfig:
     real_time_factor: float = 1.0
     real_time_update_rate: float = 1000.0
     gravity: Tuple[float, float, float] = (0.0, 0.0, -9.8)
+    # <ode><constraints> (Engine): erp for joints; penetration is undone leaving a placed body at most
+    # contact_max_correcting_vel (and the links' max_vel) of velocity; the surface layer is read, not applied.
+    erp: float = 0.2
+    contact_max_correcting_vel: float = 100.0
+    contact_surface_layer: float = 0.001
 
 
 @dataclass(frozen=True)

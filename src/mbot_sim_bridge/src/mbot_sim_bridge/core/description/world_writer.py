@@ -100,6 +100,9 @@ def _physics(world: ET.Element, physics: PhysicsConfig):
     ET.SubElement(element, "max_step_size").text = _number(physics.max_step_size)
     ET.SubElement(element, "real_time_factor").text = _number(physics.real_time_factor)
     ET.SubElement(element, "real_time_update_rate").text = _number(physics.real_time_update_rate)
+    constraints = ET.SubElement(ET.SubElement(element, "ode"), "constraints")
+    for tag in ("erp", "contact_max_correcting_vel", "contact_surface_layer"):
+        ET.SubElement(constraints, tag).text = _number(getattr(physics, tag))
 
 
 def _model_element(model: ModelDescription, pose: Pose, base: Optional[str]) -> ET.Element:
