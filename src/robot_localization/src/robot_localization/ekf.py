@@ -49,11 +49,12 @@ class Measurement:
 def valid_indices(measurement):
     """The measured members whose value, variance and covariances with the others are finite and bounded.
     Upstream drops NaN and inf values only; a NaN or huge covariance would poison the whole estimate."""
-    candidates = [i for i in np.flatnonzero(measurement.update)
-                  if np.isfinite(measurement.values[i]) and abs(measurement.values[i]) <= MEASUREMENT_LIMIT]
-    block = measurement.covariance[np.ix_(candidates, candidates)]
-    good = np.isfinite(block).all(axis=1) & (np.abs(np.diag(block)) <= MEASUREMENT_LIMIT) if candidates else []
-    return [index for index, keep in zip(candidates, good) if keep]
+    values = measurement.values
+    with np.errstate(invalid="ignore"):
+        candidates = np.flatnonzero(measurement.update & (np.abs(values) <= MEASUREMENT_LIMIT))
+        block = measurement.covariance[np.ix_(candidates, candidates)]
+        good = np.isfinite(block).all(axis=1) & (np.abs(np.diag(block)) <= MEASUREMENT_LIMIT)
+    return candidates[good]
 
 
 class Ekf:
@@ -139,9 +140,9 @@ class Ekf:
 
     def correct(self, measurement):
         indices = valid_indices(measurement)
-        if len(indices) < int(np.count_nonzero(measurement.update)):
+        if len(indices) < np.count_nonzero(measurement.update):
             self.rejections.append((measurement.topic, "invalid"))
-        if not indices:
+        if not len(indices):
             return
         size = len(indices)
         h = np.zeros((size, STATE_SIZE))
@@ -159,9 +160,8 @@ class Ekf:
                 return
             gain = pht @ hphr_inverse
             innovation = measurement.values[indices] - self.state[indices]
-            for row, index in enumerate(indices):
-                if index in ANGLES:
-                    innovation[row] = normalize_angle(innovation[row])
+            angles = np.isin(indices, ANGLES)
+            innovation[angles] = normalize_angle(innovation[angles])
             squared_mahalanobis = innovation @ hphr_inverse @ innovation
             # Upstream's test, with its default threshold (max double) squared to inf: only an overflow fails it.
             if not squared_mahalanobis < measurement.threshold * measurement.threshold:
@@ -187,7 +187,7 @@ class Ekf:
             self.correct(measurement)
         else:
             indices = valid_indices(measurement)
-            if not indices:
+            if not len(indices):
                 self.rejections.append((measurement.topic, "invalid"))
                 return
             self.state[indices] = measurement.values[indices]

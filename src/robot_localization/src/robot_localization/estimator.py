@@ -11,7 +11,7 @@ import numpy as np
 
 from .ekf import (AX, AZ, MEASUREMENT_LIMIT, PITCH, ROLL, STATE_SIZE, VPITCH, VROLL, VX, VYAW, VZ, YAW, Z,
                   Ekf, Measurement, normalize_angle)
-from .geometry import Transform, block_rotation, matrix_rpy, quaternion_matrix, rpy_matrix, update_mask
+from .geometry import Transform, block_rotation, cross, matrix_rpy, quaternion_matrix, rpy_matrix, update_mask
 
 # The members two_d_mode pins to zero, and the variance it gives them.
 TWO_D_MEMBERS = [Z, ROLL, PITCH, VZ, VROLL, VPITCH, AZ]
@@ -144,7 +144,8 @@ class Estimator:
                       f"previous message received, this message will be ignored (message time: "
                       f"{message.stamp:.3f})")
             return
-        prepared = prepare(message, source, previous_stamp=previous_stamp, **options)
+        with np.errstate(all="ignore"):  # NaN and inf are found and reported when the filter takes the data
+            prepared = prepare(message, source, previous_stamp=previous_stamp, **options)
         if prepared is not None:
             values, covariance, update = prepared
             heapq.heappush(self.queue, (message.stamp, next(self.sequence), Measurement(
@@ -221,7 +222,7 @@ class Estimator:
         values, covariance = np.zeros(STATE_SIZE), np.zeros((STATE_SIZE, STATE_SIZE))
         values[VROLL:VYAW + 1] = rotation @ message.angular
         # A sensor away from the origin sees the body's turning as linear velocity.
-        values[VX:VZ + 1] = rotation @ message.linear + np.cross(offset, state_angular)
+        values[VX:VZ + 1] = rotation @ message.linear + cross(offset, state_angular)
         update[VX:VZ + 1] = update_mask(rotation, update[VX:VZ + 1])
         update[VROLL:VYAW + 1] = update_mask(rotation, update[VROLL:VYAW + 1])
         rotation6 = block_rotation(rotation)
@@ -246,8 +247,8 @@ class Estimator:
         state_angular = self.filter.state[VROLL:VYAW + 1]
         update = source.update.copy()
         values, covariance = np.zeros(STATE_SIZE), np.zeros((STATE_SIZE, STATE_SIZE))
-        values[AX:AZ + 1] = (rotation @ acceleration + np.cross(offset, self.angular_acceleration)
-                             - np.cross(np.cross(offset, state_angular), state_angular))
+        values[AX:AZ + 1] = (rotation @ acceleration + cross(offset, self.angular_acceleration)
+                             - cross(cross(offset, state_angular), state_angular))
         update[AX:AZ + 1] = update_mask(rotation, update[AX:AZ + 1])
         covariance[AX:AZ + 1, AX:AZ + 1] = rotation @ message.linear_acceleration_covariance @ rotation.T
         return self.force_two_d(values, covariance, update)

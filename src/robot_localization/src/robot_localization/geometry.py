@@ -73,4 +73,9 @@ def block_rotation(rotation):
 def update_mask(rotation, update):
     """Which members a rotated measurement touches: upstream rotates the diagonal mask and keeps the rows whose
     length is at least 1e-6."""
-    return np.linalg.norm(rotation @ np.diag(np.asarray(update, dtype=float)), axis=1) >= 1e-6
+    return (rotation * rotation) @ np.asarray(update, dtype=float) >= 1e-12
+
+
+def cross(a, b):
+    """The cross product of two 3-vectors (numpy's is slow for one pair)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])

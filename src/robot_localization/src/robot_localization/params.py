@@ -184,9 +184,9 @@ def unknown_line(name, parameters):
     match = SENSOR_NAME.match(name)
     if match:
         kind, index, setting = match.group(1), int(match.group(2)), match.group(3)
-        missing = next(i for i in range(index + 1) if f"{kind}{i}" not in parameters)
-        if missing < index or f"{kind}{index}" not in parameters:
-            return (f"~{name}: not read, {kind}{missing} is missing (sensors are numbered from 0 without gaps)")
+        missing = next((i for i in range(index + 1) if f"{kind}{i}" not in parameters), None)
+        if missing is not None:
+            return f"~{name}: not read, {kind}{missing} is missing (sensors are numbered from 0 without gaps)"
         if setting in UNSUPPORTED_SENSOR_SETTINGS:
             return f"~{name}: not supported by this ekf_localization_node, ignored"
         return f"~{name}: unknown setting for a {kind} input (known: {', '.join(sorted(SENSOR_SETTINGS[kind]))})"
