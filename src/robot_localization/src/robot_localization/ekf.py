@@ -47,13 +47,14 @@ class Measurement:
 
 
 def valid_indices(measurement):
-    """The measured members whose value, variance and covariances with the others are finite and bounded.
+    """The measured members whose value, variance and covariances with the others are finite and bounded (NaN
+    fails every comparison).
     Upstream drops NaN and inf values only; a NaN or huge covariance would poison the whole estimate."""
     values = measurement.values
     with np.errstate(invalid="ignore"):
         candidates = np.flatnonzero(measurement.update & (np.abs(values) <= MEASUREMENT_LIMIT))
         block = measurement.covariance[np.ix_(candidates, candidates)]
-        good = np.isfinite(block).all(axis=1) & (np.abs(np.diag(block)) <= MEASUREMENT_LIMIT)
+        good = (np.abs(block) <= MEASUREMENT_LIMIT).all(axis=1)
     return candidates[good]
 
 
