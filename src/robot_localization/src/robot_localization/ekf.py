@@ -7,7 +7,7 @@ measurement's values whose number, variance or covariance is not finite or beyon
 out of the update as upstream leaves out NaN and inf values, and an update that would leave the state or its
 covariance non-finite is undone; ``Ekf.rejections`` says why, for the node to report.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -43,7 +43,6 @@ class Measurement:
     covariance: np.ndarray
     update: np.ndarray
     threshold: float = float("inf")
-    sequence: int = field(default=0, compare=False)
 
 
 def valid_indices(measurement):

@@ -1,6 +1,8 @@
 """The filter core without ROS: upstream's measurement test, the Jacobian against the transfer function, the
 sensor mapping (IMU mounted rotated, differential, two_d_mode), bad input and the parameters."""
 import heapq
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -199,3 +201,9 @@ def test_covariance_given_as_yaml_strings_is_read_as_upstream_reads_it():
     config, lines = read({"initial_estimate_covariance": ["1e-9" if i % 16 == 0 else 0 for i in range(225)]})
     assert lines == [] or all("~initial" not in line for line in lines)
     assert np.allclose(np.diag(config.initial_estimate_covariance), 1e-9)
+
+
+def test_the_filter_core_imports_no_ros():
+    code = ("import sys; import robot_localization.ekf, robot_localization.estimator, robot_localization.params; "
+            "sys.exit('rospy' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
