@@ -3,6 +3,7 @@
 relative modes, two_d_mode), the measurement queue in time order and the periodic update. The node hands in
 messages as the plain records below and a ``lookup(target, source, stamp)`` that returns a ``Transform`` or None.
 """
+import collections
 import heapq
 import itertools
 from dataclasses import dataclass
@@ -94,6 +95,9 @@ class Estimator:
         self.angular_acceleration = np.zeros(3)
         self.angular_acceleration_covariance = np.zeros((3, 3))
         self.last_angular_velocity, self.last_differentiation_time = np.zeros(3), 0.0
+        # smooth_lagged_data: filter states and measurements of the last history_length seconds, oldest first.
+        self.history_length = None
+        self.state_history, self.measurement_history = collections.deque(), collections.deque()
 
     # Inputs, as upstream's callbacks.
     def odometry(self, pose, twist, pose_source, twist_source):
@@ -271,15 +275,54 @@ class Estimator:
     # The periodic update.
     def integrate(self, now):
         """RosFilter::integrateMeasurements: every queued measurement up to ``now`` in time order; with none
-        queued for sensor_timeout (or with predict_to_current_time) a prediction up to ``now``."""
+        queued for sensor_timeout (or with predict_to_current_time) a prediction up to ``now``. With
+        smooth_lagged_data (``history_length`` set), a measurement older than the estimate first takes the filter
+        back to the state before it, and the measurements since are fused again."""
         predict = self.predict_to_current_time
+        smoothing = self.history_length is not None
         if self.queue:
+            if smoothing and self.queue[0][0] < self.filter.last_measurement_time:
+                self.revert_to(self.queue[0][0] - 1e-9)
             while self.queue and self.queue[0][0] <= now:
-                self.filter.process_measurement(heapq.heappop(self.queue)[2])
+                measurement = heapq.heappop(self.queue)[2]
+                self.filter.process_measurement(measurement)
+                if smoothing:
+                    self.measurement_history.append(measurement)
+                    # One saved state per distinct time.
+                    if not self.queue or abs(self.queue[0][0] - self.filter.last_measurement_time) > 1e-9:
+                        self.state_history.append((self.filter.last_measurement_time, self.filter.state.copy(),
+                                                   self.filter.covariance.copy()))
         elif self.filter.initialized and now - self.filter.last_measurement_time >= self.filter.sensor_timeout:
             predict = True
         if self.filter.initialized and predict:
             self.filter.predict_to(now)
+        if smoothing:
+            self.forget_before(self.filter.last_measurement_time - self.history_length)
+
+    def revert_to(self, time):
+        """RosFilter::revertTo: the last saved state at or before ``time`` (the oldest one if the history is too
+        short, with a warning), and the measurements after it back into the queue."""
+        popped = None
+        while self.state_history and self.state_history[-1][0] > time:
+            popped = self.state_history.pop()
+        restored = self.state_history[-1] if self.state_history else popped
+        if not self.state_history and popped is not None:
+            self.warn("history_length", f"Could not revert to state with time {time:.3f}: the history "
+                      f"(history_length {self.history_length} s) is too short; reverted to {popped[0]:.3f}")
+        if restored is None:
+            return
+        self.filter.last_measurement_time, state, covariance = restored
+        self.filter.state, self.filter.covariance = state.copy(), covariance.copy()
+        while self.measurement_history and self.measurement_history[-1].time > time:
+            measurement = self.measurement_history.pop()
+            if restored[0] <= measurement.time:
+                heapq.heappush(self.queue, (measurement.time, next(self.sequence), measurement))
+
+    def forget_before(self, cutoff):
+        while self.measurement_history and self.measurement_history[0].time < cutoff:
+            self.measurement_history.popleft()
+        while self.state_history and self.state_history[0][0] < cutoff:
+            self.state_history.popleft()
 
     def differentiate(self, now):
         """The angular acceleration accel/filtered reports, differentiated from the estimated angular velocity."""
@@ -301,6 +344,8 @@ class Estimator:
         self.initial_measurements.clear()
         self.previous_measurements.clear()
         self.queue.clear()
+        self.state_history.clear()
+        self.measurement_history.clear()
         self.last_set_pose_time = message.stamp
         covariance = np.eye(STATE_SIZE) * SET_POSE_VARIANCE
         update = np.ones(STATE_SIZE, dtype=bool)

@@ -20,11 +20,11 @@ SENSOR_SETTINGS = {
             "twist_rejection_threshold", "linear_acceleration_rejection_threshold",
             "remove_gravitational_acceleration"},
 }
-# Upstream's names this node reads and ignores, with a warning: control input, lagged-data smoothing, the
+# Upstream's names this node reads and ignores, with a warning: control input, the reset on a time jump, the
 # debug file, and the services that go with them.
 UNSUPPORTED = {"use_control", "stamped_control", "control_timeout", "control_config", "acceleration_limits",
-               "acceleration_gains", "deceleration_limits", "deceleration_gains", "smooth_lagged_data",
-               "history_length", "reset_on_time_jump", "disabled_at_startup", "debug", "debug_out_file",
+               "acceleration_gains", "deceleration_limits", "deceleration_gains", "reset_on_time_jump",
+               "disabled_at_startup", "debug", "debug_out_file",
                "permit_corrected_publication"}
 UNSUPPORTED_SENSOR_SETTINGS = {"pose_use_child_frame"}
 SENSOR_NAME = re.compile(r"^(odom|pose|twist|imu)(\d+)(?:_(.+))?$")
@@ -32,7 +32,8 @@ FRAME_PARAMETERS = ("map_frame", "odom_frame", "base_link_frame", "base_link_fra
 GLOBAL = {"frequency", "sensor_timeout", "two_d_mode", "publish_tf", "publish_acceleration", "invert_tf",
           "transform_time_offset", "transform_timeout", "predict_to_current_time", "print_diagnostics",
           "process_noise_covariance", "initial_estimate_covariance", "dynamic_process_noise_covariance",
-          "gravitational_acceleration", "initial_state", "tf_prefix", *FRAME_PARAMETERS}
+          "gravitational_acceleration", "initial_state", "tf_prefix", "smooth_lagged_data", "history_length",
+          *FRAME_PARAMETERS}
 
 
 @dataclass
@@ -64,6 +65,7 @@ class Config:
     initial_estimate_covariance: np.ndarray = None
     dynamic_process_noise_covariance: bool = False
     initial_state: np.ndarray = None
+    history_length: float = None  # seconds of history kept with smooth_lagged_data, None without
     sensors: list = field(default_factory=list)
 
 
@@ -155,6 +157,13 @@ def read_config(parameters):
     config.transform_time_offset = reader.number("transform_time_offset", 0.0)
     config.transform_timeout = reader.number("transform_timeout", 0.0, minimum=0.0)
     config.predict_to_current_time = reader.boolean("predict_to_current_time", False)
+    smooth_lagged_data = reader.boolean("smooth_lagged_data", False)
+    history_length = abs(reader.number("history_length", 0.0))
+    if smooth_lagged_data:
+        config.history_length = history_length
+    elif history_length > 1e-9:
+        reader.problem("warn", f"~history_length: {history_length} specified, but smooth_lagged_data is false. "
+                       "Lagged data will not be smoothed.")
     config.print_diagnostics = reader.boolean("print_diagnostics", True)
     config.gravitational_acceleration = reader.number("gravitational_acceleration", 9.80665)
     config.dynamic_process_noise_covariance = reader.boolean("dynamic_process_noise_covariance", False)

@@ -76,6 +76,7 @@ class RosFilter:
         if config.initial_estimate_covariance is not None:
             ekf.covariance = config.initial_estimate_covariance.copy()
         ekf.last_measurement_time = rospy.Time.now().to_sec()
+        self.estimator.history_length = config.history_length
         self.last_published_stamp = None
         self.odometry_publisher = rospy.Publisher("odometry/filtered", Odometry, queue_size=20)
         self.accel_publisher = (rospy.Publisher("accel/filtered", AccelWithCovarianceStamped, queue_size=20)

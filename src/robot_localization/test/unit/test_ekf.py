@@ -207,3 +207,26 @@ def test_the_filter_core_imports_no_ros():
     code = ("import sys; import robot_localization.ekf, robot_localization.estimator, robot_localization.params; "
             "sys.exit('rospy' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+@pytest.mark.parametrize("history_length, same", [(None, False), (1.0, True)])
+def test_late_data_is_fused_in_order_with_smooth_lagged_data(history_length, same):
+    """A measurement arriving after the prediction went past its stamp: lost motion without smoothing, the
+    in-order estimate with it (upstream's smooth_lagged_data)."""
+    source = Source("twist0", members(VX, VYAW))
+
+    def twist(stamp, speed):
+        return TwistInput(stamp, "base_link", np.array([speed, 0, 0]), np.array([0, 0, 0.5]), np.eye(6) * 1e-4)
+    in_order, late = (Estimator(lambda *args: Transform(), lambda *args: None) for _ in range(2))
+    late.history_length = history_length
+    for estimator in (in_order, late):
+        estimator.twist(twist(1.0, 1.0), source)
+        estimator.integrate(1.0)
+    in_order.twist(twist(1.1, 2.0), source)
+    in_order.integrate(1.3)
+    in_order.integrate(1.3)
+    late.integrate(1.3)
+    late.twist(twist(1.1, 2.0), source)
+    late.integrate(1.3)
+    late.integrate(1.3)
+    assert np.allclose(in_order.filter.state, late.filter.state) == same
