@@ -22,12 +22,13 @@ from robot_localization.srv import SetPose
 sys.path.insert(0, os.path.join(rospkg.RosPack().get_path("mbot_tests"), "nodes"))
 from sim_support import WALL_TIMEOUT, wait_for, yaw_of  # noqa: E402
 
-# Live, this 4 m drive ends 0.3 to 2.8 % of the distance from the ground truth on a quiet machine and up to 7.7 %
-# on one starved by other processes: data that arrives after sensor_timeout (1/frequency here, upstream's default)
-# is fused after the prediction went past its stamp, as upstream does, and the motion in between is lost. The 2 %
-# acceptance is checked on the recorded 11 m drive (test/unit/test_rover_drive.py); here the filter must stay
-# within 10 %.
-ACCEPTED_FRACTION = 0.10
+# The node runs Clearpath's configuration with smooth_lagged_data: on a loaded machine its callbacks run late,
+# and without smoothing data arriving after sensor_timeout (1/frequency here) is fused after the prediction went
+# past its stamp, as upstream does, losing the motion in between (up to 8.7 % of this drive seen live). With it,
+# live runs end 1.9 to 2.0 % of the distance from the ground truth under a load average of 17 on two cores; the
+# 2 % acceptance with Clearpath's configuration unchanged is checked on the recorded 11 m drive
+# (test/unit/test_rover_drive.py).
+ACCEPTED_FRACTION = 0.04
 
 
 def finite(odometry):
