@@ -51,7 +51,8 @@ def read_scales() -> Scales:
         positive = _axis_map("~max_positive_linear_velocity", 1.0)
         negative = _axis_map("~max_negative_linear_velocity", -1.0)
         for axis in scales.linear:
-            for limits, name in ((positive, "max_positive_linear_velocity"), (negative, "max_negative_linear_velocity")):
+            for limits, name in ((positive, "max_positive_linear_velocity"),
+                                 (negative, "max_negative_linear_velocity")):
                 if axis not in limits:
                     rospy.logwarn(f"parameter {rospy.resolve_name('~' + name)} has no {axis}: 0 is used, as "
                                   "upstream does, so that direction is stopped")

@@ -16,7 +16,8 @@ LOCK_CHECK_PERIOD = 0.05
 
 class TwistMuxNode:
     def __init__(self):
-        inputs, input_errors = parse_handles("velocity", rospy.get_param("~topics", None), rospy.resolve_name("~topics"))
+        inputs, input_errors = parse_handles("velocity", rospy.get_param("~topics", None),
+                                             rospy.resolve_name("~topics"))
         locks, lock_errors = parse_handles("lock", rospy.get_param("~locks", None), rospy.resolve_name("~locks"))
         for error in input_errors + lock_errors:
             rospy.logerr(error)
