@@ -14,8 +14,8 @@ from geometry_msgs.msg import Twist
 from rosgraph_msgs.msg import Log
 from std_msgs.msg import Bool
 
-# Wall seconds: generous for a loaded machine; the tests wait on conditions, so they take what the node takes.
-TIMEOUT = 10.0
+from sim_support import wait_for
+
 # The configuration's longest input timeout (input1), and a margin for the messages in flight.
 LONGEST_INPUT_TIMEOUT = 0.7
 SETTLE = 0.3
@@ -25,15 +25,6 @@ def twist(x=0.0, r=0.0):
     message = Twist()
     message.linear.x, message.angular.z = x, r
     return message
-
-
-def wait_for(condition, what, timeout=TIMEOUT):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.005)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
 
 
 class RatePublishers:
@@ -79,7 +70,8 @@ class TwistMuxSystem(unittest.TestCase):
         # Upstream's test launch keeps lock_1 (priority 255, timeout 0.5 s) alive with false at 20 Hz.
         cls.rates.pub("lock_1", Bool(False), rate=20)
         for topic in ("vel_1", "vel_2", "vel_3", "lock_1", "lock_2"):
-            wait_for(lambda: cls.rates.publishers[topic].get_num_connections() > 0, f"twist_mux to subscribe {topic}")
+            wait_for(lambda: cls.rates.publishers[topic].get_num_connections() > 0,
+                     what=f"twist_mux to subscribe {topic}")
 
     def setUp(self):
         """As upstream's tearDown: the inputs quiet and the locks free, past the longest input timeout."""
@@ -97,7 +89,7 @@ class TwistMuxSystem(unittest.TestCase):
         def latest_is_expected():
             latest = self.since_mark()
             return latest and latest[-1] == expected
-        wait_for(latest_is_expected, what)
+        wait_for(latest_is_expected, what=what)
         self.mark = time.monotonic()
 
     def test_empty(self):
@@ -160,7 +152,7 @@ class TwistMuxSystem(unittest.TestCase):
         self.assertNotIn(twist(2.0), self.since_mark(), "input1 passed under lock_2 sent as 255")
 
     def test_diagnostics(self):
-        wait_for(lambda: self.diagnostics, "a message on /diagnostics")
+        wait_for(lambda: self.diagnostics, what="a message on /diagnostics")
         status = self.diagnostics[-1].status[0]
         values = {value.key: value.value for value in status.values}
         self.assertEqual((status.name, status.message, status.hardware_id), ("twist_mux: Twist mux status", "ok",
@@ -171,4 +163,4 @@ class TwistMuxSystem(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    rostest.rosrun("twist_mux", "twist_mux_system", TwistMuxSystem)
+    rostest.rosrun("mbot_tests", "twist_mux_system", TwistMuxSystem)
