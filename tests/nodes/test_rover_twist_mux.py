@@ -14,19 +14,13 @@ from geometry_msgs.msg import Pose, Twist
 from std_msgs.msg import Bool
 from visualization_msgs.msg import InteractiveMarkerFeedback
 
-from sim_support import print_figures, wait_for, wait_for_running_controllers, yaw_of
+from sim_support import print_figures, twist, wait_for, wait_for_running_controllers, yaw_of
 
 CONTROLLER = "rover_velocity_controller"
 # The e-stop's limit, and what "stopped" means for the ground truth: the rover's speed (m/s).
 STOP_WITHIN_SIM_SECONDS = 0.1
 STOPPED_SPEED = 0.01
 E_STOP_SPEED = 0.15
-
-
-def twist(linear=0.0, angular=0.0):
-    message = Twist()
-    message.linear.x, message.angular.z = linear, angular
-    return message
 
 
 class RoverTwistMux(unittest.TestCase):

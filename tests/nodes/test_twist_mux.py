@@ -14,17 +14,11 @@ from geometry_msgs.msg import Twist
 from rosgraph_msgs.msg import Log
 from std_msgs.msg import Bool
 
-from sim_support import wait_for
+from sim_support import twist, wait_for
 
 # The configuration's longest input timeout (input1), and a margin for the messages in flight.
 LONGEST_INPUT_TIMEOUT = 0.7
 SETTLE = 0.3
-
-
-def twist(x=0.0, r=0.0):
-    message = Twist()
-    message.linear.x, message.angular.z = x, r
-    return message
 
 
 class RatePublishers:
