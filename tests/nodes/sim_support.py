@@ -18,6 +18,13 @@ def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
     return wait_until(condition, timeout, what)
 
 
+def twist(linear=0.0, angular=0.0) -> Twist:
+    """A planar base's command: linear.x and angular.z."""
+    message = Twist()
+    message.linear.x, message.angular.z = linear, angular
+    return message
+
+
 def print_figures(lines):
     """A test's measurements, one ``figure:`` line each on stderr, where ./mbot test picks them up."""
     print("\n".join([""] + ["figure: " + line for line in lines]), file=sys.stderr)
@@ -88,9 +95,7 @@ class Simulator:
         return state.header.stamp.to_sec(), state.pose, state.twist
 
     def command(self, linear=0.0, angular=0.0):
-        twist = Twist()
-        twist.linear.x, twist.angular.z = linear, angular
-        self.cmd_vel.publish(twist)
+        self.cmd_vel.publish(twist(linear, angular))
 
     def wait_sim_time(self, seconds):
         """Wait until ``seconds`` of sim time have passed; returns the ground truth then."""
