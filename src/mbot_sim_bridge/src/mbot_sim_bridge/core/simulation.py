@@ -19,6 +19,7 @@ from .body_wrenches import BodyWrenches, requested_job
 from .engine import Engine
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, compose, inverse
+from .joints.model_configuration import requested_positions
 from .log import get_logger, warn_once
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext, SpawnedModel
@@ -207,6 +208,22 @@ class Simulation:
         """Move a model and set its velocity (set_model_state, set from outside the physics)."""
         self.engine.set_model_state(name, pose, linear, angular)
         self.version += 1
+
+    def set_model_configuration(self, name: str, joint_names: Sequence[str], positions: Sequence[float]) -> List[str]:
+        """set_model_configuration: joints of robot ``name`` set exactly, at rest, before its next step, its
+        plugins told (ros_control's controllers then start from, or hold, the new positions); returns the
+        requested joints the model has none of (ignored, as Gazebo ignores them). A world model has no joints."""
+        if name not in self.model_names():
+            raise ModelError("SetModelConfiguration: model does not exist")
+        spawned = self.models.get(name)
+        joints, movable = (spawned.robot.model.joints, spawned.robot.movable_joints) if spawned else ({}, ())
+        wanted, missing = requested_positions(joints, movable, joint_names, positions)
+        if wanted:
+            self.engine.set_joint_positions(spawned.robot, wanted)
+            self.version += 1
+            for plugin in list(spawned.plugins):
+                self._guarded(plugin, plugin.joints_set, wanted)
+        return missing
 
     def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
         plugins: List[Plugin] = []
