@@ -3,7 +3,8 @@
 1e-4 rad (m for the fingers), the right finger follows its mimic leader, and after a second of sim time the
 trajectory controller still holds them (its desired state within 1e-4 of them). /gazebo/set_model_configuration
 answers bad requests with upstream's message or one naming the value, and nothing moves; spawn_model -J names a
-joint the model lacks in one line and sets the others."""
+joint the model lacks in one line and sets the others. get_model_properties and get_link_state answer through ROS
+with upstream's messages."""
 import math
 import subprocess
 import tempfile
@@ -12,7 +13,7 @@ import unittest
 import rospy
 import rostest
 from control_msgs.msg import JointTrajectoryControllerState
-from gazebo_msgs.srv import SetModelConfiguration
+from gazebo_msgs.srv import GetLinkState, GetModelProperties, SetModelConfiguration
 from sensor_msgs.msg import JointState
 
 from sim_support import print_figures, wait_for, wait_for_running_controllers
@@ -90,6 +91,27 @@ class ArmInitialJoints(unittest.TestCase):
         lines = [line for line in run.stderr.splitlines() if "no_such_joint" in line]
         self.assertEqual(len(lines), 1, run.stderr)
         self.assertIn("model 'pendulum' has no movable joint 'no_such_joint'", lines[0])
+
+    def test_model_properties_and_link_state(self):
+        rospy.wait_for_service("/gazebo/get_link_state", timeout=30.0)
+        properties = rospy.ServiceProxy("/gazebo/get_model_properties", GetModelProperties)
+        link_state = rospy.ServiceProxy("/gazebo/get_link_state", GetLinkState)
+        arm = properties("robot")
+        self.assertTrue(arm.success)
+        self.assertEqual(arm.status_message, "GetModelProperties: got properties")
+        self.assertIn("wrist_3_link", arm.body_names)
+        self.assertTrue(set(INITIAL) <= set(arm.joint_names), arm.joint_names)
+        self.assertEqual(properties("no_such_model").status_message, "GetModelProperties: model does not exist")
+        wrist = link_state("robot::wrist_3_link", "robot::wrist_3_link")
+        self.assertTrue(wrist.success)
+        self.assertEqual((wrist.status_message, wrist.link_state.reference_frame),
+                         ("GetLinkState: got state", "robot::wrist_3_link"))
+        self.assertLess(abs(wrist.link_state.pose.position.x) + abs(wrist.link_state.pose.position.z), 1e-6)
+        self.assertEqual(link_state("wrist_3_link", "").status_message,
+                         "GetLinkState: link not found, did you forget to scope the link by model name?")
+        self.assertEqual(link_state("robot::wrist_3_link", "nowhere").status_message,
+                         "GetLinkState: reference reference_frame not found, did you forget to scope the link by "
+                         "model name?")
 
     @staticmethod
     def arm_state():
