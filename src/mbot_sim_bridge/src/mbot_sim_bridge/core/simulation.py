@@ -36,6 +36,7 @@ LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
 MAX_BATCH_SIM_SECONDS = 0.01
 
+
 class ModelProperties(NamedTuple):
     """get_model_properties' answer: link (body) names, collision (geom) names, joint names, static."""
     body_names: List[str]

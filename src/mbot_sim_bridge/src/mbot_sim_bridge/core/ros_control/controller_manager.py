@@ -213,7 +213,6 @@ class ControllerManager:
             self._switch_request = None
             done.set()
 
-
     def restart_running(self, now: float):
         """Every running controller stopped and started again: it holds (or starts from) where the joints are."""
         for loaded in self.controllers:
