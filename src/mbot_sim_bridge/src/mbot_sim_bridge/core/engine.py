@@ -259,6 +259,11 @@ class SpawnedRobot:
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.TORQUE_CONTROL,
                                           force=effort)
 
+    def set_joint_positions(self, positions: Dict[str, float]):
+        """Joints put at positions, at rest (set_model_configuration), outside the physics."""
+        for joint_name, position in positions.items():
+            self.client.resetJointState(self.body, self.joint_index[joint_name], position, 0.0)
+
     def release_joint(self, joint_name: str):
         """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
         self.set_joint_velocity(joint_name, 0.0, 0.0)
@@ -431,6 +436,11 @@ class Engine:
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)
         self._settle(body)
+
+    def set_joint_positions(self, robot: SpawnedRobot, positions: Dict[str, float]):
+        """Joints of a robot put at positions, at rest (set_model_configuration)."""
+        robot.set_joint_positions(positions)
+        self._settle(robot.body, anchored=robot.model.anchored)
 
     def reset_world(self):
         """Every model back to its spawn pose and joint positions, at rest (Gazebo's reset_world)."""

@@ -161,6 +161,9 @@ class Plugin:
         """When ``timer`` is due but nothing takes the outputs (the ROS layer calls it instead of ``update``
         while no one subscribes, as gazebo_ros's sensors work only then): keep what the next update needs."""
 
+    def joints_set(self, positions: Dict[str, float]):
+        """set_model_configuration put these joints at these positions, at rest, between two steps."""
+
     def reset(self, now: float):
         """World or simulation reset (Gazebo calls the plugin's Reset())."""
         self.timer.reset(now)

@@ -8,17 +8,18 @@ ROS layer's registry derived from it, so the core never imports the ROS plugin l
 """
 import hashlib
 from dataclasses import replace
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
+from typing import Callable, Dict, List, Mapping, NamedTuple, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
 
 import numpy as np
 import pybullet
 
 from .added_plugins import joint_state_blocks, mimic_blocks
-from .body_wrenches import BodyWrenches, requested_job
-from .engine import Engine
+from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
+from .engine import Engine, frame_velocity
 from .errors import ConfigError, ModelError
-from .geometry import IDENTITY, Pose, compose, inverse
+from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
+from .joints.model_configuration import requested_positions
 from .log import get_logger, warn_once
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext, SpawnedModel
@@ -34,6 +35,15 @@ _logger = get_logger(__name__)
 LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
 MAX_BATCH_SIM_SECONDS = 0.01
+
+
+class ModelProperties(NamedTuple):
+    """get_model_properties' answer: link (body) names, collision (geom) names, joint names, static."""
+    body_names: List[str]
+    geom_names: List[str]
+    joint_names: List[str]
+    is_static: bool
+
 
 # Called before the due plugins update: (sim time, whether any plugin is due). The node publishes /clock there.
 BeforeUpdates = Callable[[float, bool], None]
@@ -193,6 +203,49 @@ class Simulation:
         model, _, link = name.partition("::")
         return self._link_pose(model, link) if link in self.link_names(model) else None
 
+    def _entity_twist(self, name: str) -> Tuple[Vector, Vector]:
+        """World (linear velocity of the frame's origin, angular velocity) of a model or an existing "model::link"."""
+        if name in self.model_names():
+            return self.engine.model_velocity(name)
+        model, _, link = name.partition("::")
+        if model in self.models:
+            return self.models[model].robot.link_world_velocity(link)
+        return frame_velocity(self.engine.client, self.engine.body_of(model), self._link_pose(model, link).position)
+
+    def link_state(self, link_name: str, reference_frame: str) -> Tuple[Pose, Vector, Vector]:
+        """get_link_state: a "model::link"'s pose and (linear, angular) velocity relative to any entity, as
+        gazebo_ros computes them (the velocities are the differences with the frame's, rotated into it)."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError("GetLinkState: link not found, did you forget to scope the link by model name?")
+        pose, (linear, angular) = self._link_pose(model, link), self._entity_twist(link_name)
+        frame = self._entity_pose(reference_frame)
+        if frame is None:
+            if reference_frame in WORLD_FRAMES:
+                return pose, tuple(linear), tuple(angular)
+            raise ModelError("GetLinkState: reference reference_frame not found, did you forget to scope the link by "
+                             "model name?")
+        frame_linear, frame_angular = self._entity_twist(reference_frame)
+        back = inverse(frame)
+        return (compose(back, pose), rotate(back.orientation, np.subtract(linear, frame_linear)),
+                rotate(back.orientation, np.subtract(angular, frame_angular)))
+
+    def model_properties(self, name: str) -> ModelProperties:
+        """get_model_properties: the links and joints the physics has (a robot's after fixed-joint lumping, as
+        Gazebo's), their collisions by sdformat's names; no nested models."""
+        if name not in self.model_names():
+            raise ModelError("GetModelProperties: model does not exist")
+        if name in self.models:
+            robot = self.models[name].robot
+            collisions = robot.model.collision_names()
+            return ModelProperties(list(robot.link_index), [collision for link in robot.link_index
+                                                            for collision in collisions.get(link, [])],
+                                   list(robot.joint_index), False)
+        description = self.world_models[name]
+        return ModelProperties([link.name for link in description.links],
+                               [shape.name for link in description.links for shape in link.collisions], [],
+                               description.static)
+
     def _apply_wrenches(self):
         for (model, link), (force, torque) in self.wrenches.due(self.sim_time).items():
             if model in self._frozen:
@@ -207,6 +260,22 @@ class Simulation:
         """Move a model and set its velocity (set_model_state, set from outside the physics)."""
         self.engine.set_model_state(name, pose, linear, angular)
         self.version += 1
+
+    def set_model_configuration(self, name: str, joint_names: Sequence[str], positions: Sequence[float]) -> List[str]:
+        """set_model_configuration: joints of robot ``name`` set exactly, at rest, before its next step, its
+        plugins told (ros_control's controllers then start from, or hold, the new positions); returns the
+        requested joints the model has none of (ignored, as Gazebo ignores them). A world model has no joints."""
+        if name not in self.model_names():
+            raise ModelError("SetModelConfiguration: model does not exist")
+        spawned = self.models.get(name)
+        joints, movable = (spawned.robot.model.joints, spawned.robot.movable_joints) if spawned else ({}, ())
+        wanted, missing = requested_positions(joints, movable, joint_names, positions)
+        if wanted:
+            self.engine.set_joint_positions(spawned.robot, wanted)
+            self.version += 1
+            for plugin in list(spawned.plugins):
+                self._guarded(plugin, plugin.joints_set, wanted)
+        return missing
 
     def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
         plugins: List[Plugin] = []

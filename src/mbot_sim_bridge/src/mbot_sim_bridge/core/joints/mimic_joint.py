@@ -76,6 +76,10 @@ class MimicJoint(Plugin):
     def on_step(self, step_size: float):
         self.drive(step_size)
 
+    def joints_set(self, positions):
+        """Aim at the leader's new position before the next step, not at the old one."""
+        self.drive(self.context.simulation.step_size)
+
     def reset(self, now: float):
         super().reset(now)
         if self.pid is not None:

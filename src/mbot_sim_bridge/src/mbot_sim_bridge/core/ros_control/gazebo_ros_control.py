@@ -14,7 +14,7 @@ odometry, the PID controllers' state), keeps that step's values and stamp and go
 the loop stops only where a controller publishes from its state at a stop (``Controller.steps_until_publish``).
 """
 import sys
-from typing import List
+from typing import Dict, List, Set
 
 from .. import names
 from ..log import get_logger, warn_once
@@ -24,6 +24,7 @@ from ..plugin import Plugin
 from ..description.robot_model import RobotModel, parse_robot
 from .controller_table import CORE_CONTROLLERS
 from .controller_manager import ControllerManager
+from .hardware_interface import UNBOUNDED_EFFORT
 from .robot_hw_sim import ROBOT_HW_SIMS
 from .transmissions import parse_transmissions
 from ..xml_values import XmlDocument
@@ -122,6 +123,7 @@ class GazeboRosControlPlugin(Plugin):
         self._engine = context.engine  # the sim time without the Simulation's property, after every step
         self.e_stop = False
         self._last_e_stop = False
+        self._pinned: Dict[str, float] = {}  # joints held at set_model_configuration's positions (joints_set)
 
     def _robot_description(self, param_name: str) -> RobotModel:
         """The URDF in ``robotParam``, searched from the robot namespace upwards (NodeHandle::searchParam), with
@@ -152,9 +154,15 @@ class GazeboRosControlPlugin(Plugin):
                 self._last_e_stop = True
             elif self._last_e_stop:
                 reset, self._last_e_stop = True, False
+            if self._pinned:
+                # Before the update: a controller started by this update's switch writes no command until the
+                # next one, so its joints stay held one more step.
+                self._release_claimed()
             self.manager.update(now, period, reset)
         self.hw.write_sim(now - self.last_write)
         self.last_write = now
+        if self._pinned:
+            self._hold_pinned()
 
     def update(self, now: float):
         """Publish for the controllers whose time has come (the ROS plugin does the publishing, then calls this)."""
@@ -162,11 +170,40 @@ class GazeboRosControlPlugin(Plugin):
             loaded.controller.outbox.clear()
         self.publish_now = []
 
+    def joints_set(self, positions):
+        """The joints' new positions read exactly (readSim would unwrap a jump of more than pi), position
+        commands there, and the running controllers restarted: their holds take the new positions instead of
+        pulling the joints back (the bridge's choice; Gazebo's controllers fight set_model_configuration).
+        Effort-driven joints no running controller drives are held there by a motor until one does: else they
+        sag under gravity until the spawner starts their controller, which then holds them where they fell."""
+        self.hw.joints_set(positions)
+        self.manager.restart_running(self._engine.sim_time)
+        claimed = self._claimed_joints()
+        self._pinned = {name: position for name, position in positions.items() if name in self.hw.joints
+                        and self.hw.joints[name].motor == "effort" and name not in claimed}
+        self._hold_pinned()
+
+    def _claimed_joints(self) -> Set[str]:
+        return {joint for loaded in self.manager.controllers if loaded.state == "running"
+                for _, joints in loaded.claimed for joint in joints}
+
+    def _release_claimed(self):
+        """Pinned joints a running controller drives are let go."""
+        claimed = self._claimed_joints()
+        for name in [name for name in self._pinned if name in claimed]:
+            del self._pinned[name]
+            self.context.robot.release_joint(name)
+
+    def _hold_pinned(self):
+        for name, position in self._pinned.items():
+            self.context.robot.set_joint_position(name, position, UNBOUNDED_EFFORT)
+
     def reset(self, now: float):
         # gazebo_ros_control resets its update times; the controllers' own clocks restart too, so a
         # reset_simulation (sim time back to 0) does not silence their topics until the old time comes back.
         self.last_update = self.last_write = now
         self.hw.forget_motors()
+        self._pinned = {}
         for loaded in self.manager.controllers:
             loaded.controller.restart_clock(now)
 

@@ -326,6 +326,20 @@ class DefaultRobotHWSim:
                            f"{bound:g}; clamped")
         return math.copysign(bound, value)
 
+    def joints_set(self, positions: Dict[str, float]):
+        """set_model_configuration put joints at positions, at rest: read them as they are, and a position
+        joint's command is its new position, from the next step on, until a controller commands it (else it
+        would return to 0)."""
+        for name, position in positions.items():
+            joint = self.joints.get(name)
+            if joint is not None:
+                joint.position, joint.velocity = position, 0.0
+                if joint.interface == POSITION:
+                    joint.command = joint.previous_command = position
+                    if joint.motor == "position":
+                        joint.sent_loads, joint.sent_value = self.robot.loads, position
+                        self._set_motor(joint, "position", position)
+
     def forget_motors(self):
         """After a reset the engine's motors may have changed; send every setting again."""
         for joint in self.joints.values():
