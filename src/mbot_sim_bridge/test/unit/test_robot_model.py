@@ -1,5 +1,6 @@
 import logging
 import os
+from xml.etree import ElementTree
 
 import pytest
 
@@ -33,10 +34,13 @@ def test_course_mbot_lumps_fixed_links_like_gazebo(mbot_urdf):
     assert [p.get("filename") for p in model.plugins] == ["libgazebo_ros_diff_drive.so"]
 
 
-def test_massless_root_gets_a_negligible_inertial_for_pybullet(mbot_urdf):
+def test_a_massless_root_takes_the_mass_lumped_into_it(mbot_urdf):
     model = parse_robot(mbot_urdf)
     assert not model.links["base_footprint"].has_inertial
-    assert '<mass value="1e-09"' in model.pybullet_urdf
+    root = ElementTree.fromstring(model.pybullet_urdf).find("link[@name='base_footprint']")
+    assert root.find("inertial/mass").get("value") == "20.0"
+    assert float(root.find("inertial/origin").get("xyz").split()[2]) == pytest.approx(0.005 / 2 + 0.01975 * 2)
+    assert not ElementTree.fromstring(model.pybullet_urdf).findall("link[@name='base_link']")
     assert "<gazebo" not in model.pybullet_urdf and "<transmission" not in model.pybullet_urdf
 
 

@@ -22,7 +22,6 @@ from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
 from .world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
-from .xml_values import check_range, parse_float
 
 _logger = get_logger(__name__)
 
@@ -30,8 +29,6 @@ _logger = get_logger(__name__)
 # so poses and velocities given from outside are refused past them.
 MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
-# Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
-DEFAULT_MU = 1.0
 
 
 class CachingBulletClient(BulletClient):
@@ -104,15 +101,6 @@ def check_state(what: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0
                          f"nothing was changed")
 
 
-def _friction(text: str, model: str, link: str) -> float:
-    try:
-        value = parse_float(text)
-        check_range(value, minimum=0.0)
-    except ValueError as error:
-        raise ModelError(f"model '{model}': <gazebo reference='{link}'> friction '{text}': {error}") from None
-    return value
-
-
 class RecordedLinkStates(NamedTuple):
     """A link frame at consecutive steps, one row each, in the world."""
     orientations: np.ndarray  # (N, 4) xyzw
@@ -135,10 +123,16 @@ class SpawnedRobot:
         self.driven_joints: Tuple[str, ...] = ()
         self.loads = 1  # a new body (respawn) has every motor off, whatever a plugin set on the old one
         self.link_index: Dict[str, int] = {model.root: -1}
+        # Bullet links of lumped links kept for their own surface: not links Gazebo has, so not in link_index.
+        self.surface_link_index: Dict[str, int] = {}
         self.joint_index: Dict[str, int] = {}
         for index in range(client.getNumJoints(body)):
             info = client.getJointInfo(body, index)
-            self.link_index[info[12].decode()] = index
+            link_name = info[12].decode()
+            if link_name in model.separate_surfaces:
+                self.surface_link_index[link_name] = index
+            else:
+                self.link_index[link_name] = index
             self.joint_index[info[1].decode()] = index
         self.root_from_com = root_from_com(client, body)
         self._frames_from_com: Dict[str, Pose] = {}  # a base-lumped link's frame seen from the centre of mass
@@ -161,6 +155,11 @@ class SpawnedRobot:
             state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
             frame = Pose(tuple(state[4]), tuple(state[5]))
         return compose(frame, offset) if offset != IDENTITY else frame
+
+    def bullet_links(self, link_name: str) -> List[int]:
+        """The Bullet links holding the collisions of a simulated link: its own and its separate surfaces'."""
+        return [self.link_index[link_name]] + [index for name, index in self.surface_link_index.items()
+                                               if self.model.lumped_into[name][0] == link_name]
 
     def joint_state(self, joint_names: Sequence[str]) -> List[Tuple[float, float, float]]:
         """(position, velocity, applied effort) per named joint."""
@@ -347,10 +346,12 @@ class Engine:
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
         self.robots[robot.name] = robot
-        # A link holding several collisions is named by its first: Bullet reports contacts per link.
-        self.collision_names[robot.body] = {robot.link_index[link]: f"{robot.name}::{link}::{names[0]}"
-                                            for link, names in robot.model.collision_names().items()
-                                            if names and link in robot.link_index}
+        # A link holding several collisions is named by its first: Bullet reports contacts per link. A separate
+        # surface's Bullet link is named by its own, which Gazebo holds in the link it is lumped into.
+        indices = {**robot.link_index, **robot.surface_link_index}
+        self.collision_names[robot.body] = {
+            indices[link]: f"{robot.name}::{robot.model.lumped_into[link][0]}::{names[0]}"
+            for link, names in robot.model.bullet_collision_names().items() if names and link in indices}
         self._root_from_com[robot.body] = robot.root_from_com
         self._remember_initial_state(robot.body)
 
@@ -450,8 +451,8 @@ class Engine:
         try:
             with os.fdopen(handle, "w") as urdf_file:
                 urdf_file.write(model.pybullet_urdf)
-            flags = (pybullet.URDF_MERGE_FIXED_LINKS | pybullet.URDF_USE_INERTIA_FROM_FILE
-                     | pybullet.URDF_USE_IMPLICIT_CYLINDER)
+            # Fixed joints come lumped (RobotModel), so PyBullet's URDF_MERGE_FIXED_LINKS is not asked for.
+            flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
             # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
             with open(os.devnull, "w") as devnull, c_stdout_to(devnull):
                 body = self.client.loadURDF(path, flags=flags, useFixedBase=model.anchored)
@@ -464,40 +465,21 @@ class Engine:
         return body
 
     def set_surfaces(self, robot: SpawnedRobot, driven_joints: Sequence[str]):
-        """Friction of every link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
+        """Friction of every Bullet link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
         robot.driven_joints = tuple(driven_joints)
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
             _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
-        for link_name, index in robot.link_index.items():
+        for link_name, index in {**robot.link_index, **robot.surface_link_index}.items():
             self._set_surface(robot, link_name, index, caster=link_name in casters)
 
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
-        mu = DEFAULT_MU
-        # sdformat keeps a lumped link's <gazebo reference> surface on the collisions it brings to its parent
-        # (a base_link lumped into a base_footprint root keeps its mu); Bullet has one friction per link.
-        frictions = {}
-        for name, (body_link, _) in robot.model.lumped_into.items():
-            link = robot.model.links.get(name)
-            if body_link != link_name or link is None or (name != link_name and not link.collision_kinds):
-                continue
-            mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
-            values = [_friction(v, robot.name, name) for v in (mu1, mu2) if v is not None]
-            if len(values) == 2 and values[0] != values[1]:
-                warn_once(_logger, f"{robot.name}: link '{name}' has mu1 {mu1} and mu2 {mu2}; Bullet's friction "
-                                   "is isotropic, the smaller is used")
-            if values:
-                frictions[name] = min(values)
-        if len(set(frictions.values())) > 1:
-            warn_once(_logger, f"{robot.name}: links lumped into '{link_name}' have different friction ("
-                               f"{', '.join(f'{name} {value:g}' for name, value in sorted(frictions.items()))}); "
-                               "Bullet has one per link, the smallest is used")
-        if frictions:
-            mu = min(frictions.values())
-        if caster:
-            mu = 0.0
-        self.client.changeDynamics(robot.body, index, lateralFriction=mu, spinningFriction=0.0,
-                                   rollingFriction=0.0, restitution=0.0)
+        mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")
+        if mu1 != mu2:
+            warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1:g} and mu2 {mu2:g}; Bullet's friction "
+                               "is isotropic, the smaller is used")
+        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster else min(mu1, mu2),
+                                   spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)
