@@ -20,6 +20,7 @@ from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quatern
                        rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
+from .wheel_contact import WheelContact
 from .world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
 
@@ -262,6 +263,8 @@ class Engine:
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
+        self._wheels: Dict[int, List[WheelContact]] = {}  # per body, the friction of its wheels (wheel_contact)
+        self._before_step: List[Callable[[], None]] = []
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -286,6 +289,8 @@ class Engine:
         self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
+        self._wheels.clear()
+        self._before_step = []
 
     @property
     def sim_time(self) -> float:
@@ -295,8 +300,11 @@ class Engine:
         """``count`` physics steps; each of ``after_each`` (recorders of per-step state, then the plugins that act
         on every step) is called after every one, with ``sim_time`` already that step's."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
-        if after_each:
+        before = self._before_step
+        if after_each or before:
             for _ in range(count):
+                for call in before:
+                    call()
                 step()
                 self.steps += 1
                 for call in after_each:
@@ -365,6 +373,7 @@ class Engine:
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
         self.collision_names.pop(body, None)
+        self._set_wheels(body, [])
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -470,15 +479,36 @@ class Engine:
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
             _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
+        wheels = robot.model.wheels
         for link_name, index in {**robot.link_index, **robot.surface_link_index}.items():
-            self._set_surface(robot, link_name, index, caster=link_name in casters)
+            self._set_surface(robot, link_name, index, caster=link_name in casters, wheel=link_name in wheels)
+        source = f"model '{robot.name}'"
+        mass = sum(self.client.getDynamicsInfo(robot.body, index)[0] for index in range(-1, robot.client.getNumJoints(
+            robot.body)))
+        contacts = []
+        for link_name, (centre, axle) in wheels.items():
+            if link_name in robot.link_index:
+                mu1, mu2 = robot.model.links[link_name].surface(source)
+                contacts.append(WheelContact(self.client, robot.body, robot.link_index[link_name], centre, axle,
+                                             robot.model.fdir1(link_name, source), mu1, mu2, mass / len(wheels),
+                                             self.physics.max_step_size))
+        for link_name, link in robot.model.links.items():
+            if link.gazebo_tag("fdir1") is not None and link_name not in wheels:
+                warn_once(_logger, f"{robot.name}: link '{link_name}' <fdir1> acts on wheels only (cylinders about "
+                                   "their joint's axis); ignored")
+        self._set_wheels(robot.body, contacts)
 
-    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
+    def _set_wheels(self, body: int, contacts: List[WheelContact]):
+        self._wheels[body] = contacts
+        self._before_step = [wheel.apply for wheels in self._wheels.values() for wheel in wheels]
+
+    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, wheel: bool):
         mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")
-        if mu1 != mu2:
+        if mu1 != mu2 and not wheel:
             warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1:g} and mu2 {mu2:g}; Bullet's friction "
                                "is isotropic, the smaller is used")
-        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster else min(mu1, mu2),
+        # A wheel's friction is the wheel contact model's (wheel_contact), not Bullet's.
+        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or wheel else min(mu1, mu2),
                                    spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
 
     def _remember_initial_state(self, body: int):

@@ -21,7 +21,7 @@ from xml.etree import ElementTree
 import numpy as np
 
 from .errors import ModelError
-from .geometry import IDENTITY, Pose, compose, rotation_matrix, rpy
+from .geometry import IDENTITY, Pose, compose, rotate, rotation_matrix, rpy
 from .log import get_logger, warn_once
 from .xml_values import (XmlDocument, check_range, parse_float, parse_floats, parse_xml, read_attribute_numbers,
                          read_origin)
@@ -33,14 +33,18 @@ MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
 SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
 
 # <gazebo reference="link"> tags the bridge acts on.
-LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor")
+LINK_TAGS_USED = ("material", "mu1", "mu2", "fdir1", "sensor")
 # Tags whose Gazebo default is what Bullet does anyway: only another value is reported (value -> default).
 LINK_TAGS_DEFAULT_ONLY = {"turnGravityOff": "false", "gravity": "true", "selfCollide": "false"}
 # Tags read by Gazebo's URDF import that have no Bullet counterpart here: one warning per tag and model.
-LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", "maxContacts", "dampingFactor",
+LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "laserRetro", "maxContacts", "dampingFactor",
                        "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
                        "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
                        "preserveFixedJoint", "disableFixedJointLumping")
+# A wheel's tread (m) and how much narrower in radius its sides are (a fraction): see _with_treads. The sides
+# stay off flat ground until the wheel leans by about 2 degrees.
+TREAD_WIDTH = 0.002
+SIDE_CLEARANCE = 0.01
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
 # A negligible inertial for massless lumped links: PyBullet adds it to the parent, which leaves the
@@ -120,6 +124,8 @@ class RobotModel:
     document: XmlDocument  # the parsed robot_description: line numbers for messages
     # Lumped links simulated as a Bullet link of their own (on a fixed joint, massless) for their own surface.
     separate_surfaces: Tuple[str, ...] = ()
+    # Links that roll (see _wheels): link -> (the first cylinder's centre, the unit axle), in the link frame.
+    wheels: Dict[str, Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = field(default_factory=dict)
 
     @property
     def anchored(self) -> bool:
@@ -168,6 +174,22 @@ class RobotModel:
                 name = f"{prefix}_collision" + (f"_{index}" if index else "")
                 pose = compose(offset, read_origin(collision, self.document))
                 yield holder, link.name, name, pose, _half_extents(collision.find("geometry"))
+
+    def fdir1(self, link_name: str, source: str) -> Optional[Tuple[float, float, float]]:
+        """Gazebo's first friction direction of a link, in its frame, or None when absent or zero."""
+        text = self.links[link_name].gazebo_tag("fdir1")
+        if text is None:
+            return None
+        try:
+            direction = parse_floats(text, 3)
+        except ValueError as error:
+            raise ModelError(f"{source}: <gazebo reference='{link_name}'> <fdir1> '{text}': {error}") from None
+        largest = max(abs(value) for value in direction)
+        if largest == 0.0:
+            return None
+        # Scaled before it is squared, so that 1e308 stays finite.
+        length = math.sqrt(sum((value / largest) ** 2 for value in direction))
+        return tuple(value / largest / length for value in direction)
 
     def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
         """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
@@ -315,8 +337,50 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     separate = _separate_surfaces(links, lumped_into, source)
     pybullet_urdf = _pybullet_urdf(root, links, joints, dropped, lumped_into, separate, document, source)
     _read_collision_radii(root, links, document)
-    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, pybullet_urdf, transmissions, document,
-                      separate)
+    wheels = _wheels(root, links, joints, document)
+    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, _with_treads(pybullet_urdf, wheels),
+                      transmissions, document, separate, wheels)
+
+
+def _wheels(root: ElementTree.Element, links, joints, document: XmlDocument):
+    """Links that roll: every collision a cylinder whose axis is the axis of the link's revolute or continuous
+    joint. Link -> (the first cylinder's centre, the unit axle), in the link frame."""
+    elements = {element.get("name"): element for element in root.findall("link")}
+    found = {}
+    for joint in joints.values():
+        collisions = elements[joint.child].findall("collision") if joint.child in elements else []
+        length = math.sqrt(sum(value * value for value in joint.axis))
+        if joint.type not in ("continuous", "revolute") or not collisions or length == 0.0:
+            continue
+        axle = tuple(value / length for value in joint.axis)
+        poses = [read_origin(collision, document) for collision in collisions]
+        if all(kind == "cylinder" and abs(sum(a * b for a, b in zip(rotate(pose.orientation, (0.0, 0.0, 1.0)), axle)))
+               > 0.999 for kind, pose in zip(links[joint.child].collision_kinds, poses)):
+            found[joint.child] = (poses[0].position, axle)
+    return found
+
+
+def _with_treads(urdf: str, wheels) -> str:
+    """Each wheel cylinder as Bullet gets it: a thin tread of its radius at its mid-plane, and the cylinder a
+    little narrower in radius for what the wheel's sides touch. Bullet lets a cylinder lying on a plane touch it
+    at one rim point, which jumps between the rims as rounding tilts the wheel; that shifted the load and the
+    track of a wheeled base by half the wheel's width (see wheel_contact)."""
+    if not wheels:
+        return urdf
+    robot = ElementTree.fromstring(urdf)
+    for link in robot.findall("link"):
+        if link.get("name") not in wheels:
+            continue
+        for collision in link.findall("collision"):
+            cylinder = collision.find("geometry/cylinder")
+            radius, length = float(cylinder.get("radius")), float(cylinder.get("length"))
+            if length <= TREAD_WIDTH:
+                continue
+            tread = copy.deepcopy(collision)
+            tread.find("geometry/cylinder").set("length", repr(TREAD_WIDTH))
+            link.insert(list(link).index(collision), tread)
+            cylinder.set("radius", repr(radius * (1.0 - SIDE_CLEARANCE)))
+    return ElementTree.tostring(robot, encoding="unicode")
 
 
 def _friction(text: Optional[str], source: str, link: str, tag: str) -> float:

@@ -1,0 +1,136 @@
+"""Wheel-ground friction computed by the bridge: Coulomb friction in the wheel's own frame, at its mid-plane.
+
+Bullet gets two things wrong for wheels, and skid-steer bases show both:
+- a multibody's friction acts along two directions fixed by the contact normal alone (btPlaneSpace1), so on flat
+  ground along world x and y, each limited by mu*N: a wheel sliding diagonally gets up to 1.41 times the grip,
+  and a base turning in place speeds up and slows down with its heading (every 90 degrees);
+- a cylinder lying on a plane touches it at one rim point, which jumps between the two rims as the wheel tilts by
+  rounding: the track changes by the wheel's width (a Husky turned at 0.17 or 0.52 rad/s for 0.5).
+So a wheel (a link whose collisions are cylinders about its joint's axis) gets no Bullet friction; before every
+step each of its contacts gets the friction force computed here, from the normal force Bullet found at the last
+step, at the contact moved along the axle to the wheel's mid-plane (where ODE's two rim contacts average to).
+Along ``fdir1`` (Gazebo's first friction direction, in the wheel's frame; the rolling direction when absent) the
+limit is mu1*N and across it mu2*N, on an ellipse (Coulomb's circle when mu1 = mu2). Below the limit the force
+opposes the slip in proportion, with a gain that takes a quarter of the slip away per step: a stiff but explicit
+stand-in for static friction, which Bullet's solver would give exactly.
+"""
+import math
+from typing import Optional, Sequence, Tuple
+
+import pybullet
+
+from .geometry import rotate
+
+# Fraction of the slip velocity one step's friction takes away below the limit (see the module docstring).
+STICK_FRACTION = 0.25
+# Below this a direction (fdir1 seen edge-on) is not used, m/s or unit length.
+_TINY = 1e-9
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _unit(a) -> Optional[Tuple[float, float, float]]:
+    length = math.sqrt(_dot(a, a))
+    return None if length < _TINY else (a[0] / length, a[1] / length, a[2] / length)
+
+
+class WheelContact:
+    """The friction of one wheel link (Bullet link ``index`` of ``body``) against whatever it touches."""
+
+    def __init__(self, client, body: int, index: int, centre: Sequence[float], axis: Sequence[float],
+                 fdir1: Optional[Sequence[float]], mu1: float, mu2: float, mass_share: float, step_size: float):
+        self.client, self.body, self.index = client, body, index
+        self.centre, self.axis, self.fdir1 = tuple(centre), tuple(axis), fdir1  # in the link frame
+        self.mu1, self.mu2 = mu1, mu2
+        self.gain = STICK_FRACTION * mass_share / step_size  # N per m/s of slip, per contact point
+        self._surfaces = {}  # (body, link) -> (lateral friction, static)
+
+    def _surface(self, body: int, link: int) -> Tuple[float, bool]:
+        key = (body, link)
+        if key not in self._surfaces:
+            info = self.client.getDynamicsInfo(body, link)
+            self._surfaces[key] = (info[1], info[0] == 0.0)
+        return self._surfaces[key]
+
+    def _velocity_of(self, body: int, link: int, point) -> Tuple[float, float, float]:
+        if link == -1:
+            com, _ = self.client.getBasePositionAndOrientation(body)
+            linear, angular = self.client.getBaseVelocity(body)
+        else:
+            state = self.client.getLinkState(body, link, computeLinkVelocity=1)
+            com, linear, angular = state[0], state[6], state[7]
+        arm = (point[0] - com[0], point[1] - com[1], point[2] - com[2])
+        spin = _cross(angular, arm)
+        return (linear[0] + spin[0], linear[1] + spin[1], linear[2] + spin[2])
+
+    def apply(self):
+        client = self.client
+        points = [point for point in client.getContactPoints(bodyA=self.body, linkIndexA=self.index)
+                  if point[2] != self.body and point[9] > 0.0]
+        if not points:
+            return
+        state = client.getLinkState(self.body, self.index, computeLinkVelocity=1)
+        com, frame, orientation, linear, angular = state[0], state[4], state[5], state[6], state[7]
+        offset = rotate(orientation, self.centre)
+        centre = (frame[0] + offset[0], frame[1] + offset[1], frame[2] + offset[2])
+        axis = rotate(orientation, self.axis)
+        fdir1 = rotate(orientation, self.fdir1) if self.fdir1 is not None else None
+        gain = self.gain / len(points)
+        for point in points:
+            other, other_link, normal, normal_force = point[2], point[4], point[7], point[9]
+            friction, static = self._surface(other, other_link)
+            mu1, mu2 = self.mu1 * friction, self.mu2 * friction
+            if mu1 <= 0.0 and mu2 <= 0.0:
+                continue
+            arm = (point[5][0] - centre[0], point[5][1] - centre[1], point[5][2] - centre[2])
+            along = _dot(arm, axis)
+            at = (point[5][0] - along * axis[0], point[5][1] - along * axis[1], point[5][2] - along * axis[2])
+            spin = _cross(angular, (at[0] - com[0], at[1] - com[1], at[2] - com[2]))
+            velocity = (linear[0] + spin[0], linear[1] + spin[1], linear[2] + spin[2])
+            if not static:
+                moving = self._velocity_of(other, other_link, at)
+                velocity = (velocity[0] - moving[0], velocity[1] - moving[1], velocity[2] - moving[2])
+            first = self._first_direction(fdir1, axis, normal)
+            if first is None:
+                continue
+            second = _cross(normal, first)
+            slip1, slip2 = _dot(velocity, first), _dot(velocity, second)
+            force1, force2 = -gain * slip1, -gain * slip2
+            if _outside(force1, force2, mu1 * normal_force, mu2 * normal_force):
+                # Sliding: the force on the ellipse that dissipates most (opposite the slip when mu1 = mu2).
+                weighted = math.hypot(mu1 * slip1, mu2 * slip2)
+                if weighted < _TINY:
+                    continue
+                force1 = -normal_force * mu1 * mu1 * slip1 / weighted
+                force2 = -normal_force * mu2 * mu2 * slip2 / weighted
+            force = tuple(force1 * first[i] + force2 * second[i] for i in range(3))
+            client.applyExternalForce(self.body, self.index, force, at, pybullet.WORLD_FRAME)
+
+    @staticmethod
+    def _first_direction(fdir1, axis, normal) -> Optional[Tuple[float, float, float]]:
+        """fdir1 in the contact plane, or the rolling direction (axle x normal) when fdir1 is absent or edge-on."""
+        for direction in ((fdir1,) if fdir1 is not None else ()) + (_cross(axis, normal),):
+            along = _dot(direction, normal)
+            unit = _unit((direction[0] - along * normal[0], direction[1] - along * normal[1],
+                          direction[2] - along * normal[2]))
+            if unit is not None:
+                return unit
+        return None
+
+
+def _outside(force1: float, force2: float, limit1: float, limit2: float) -> bool:
+    """Whether (force1, force2) lies beyond the ellipse with these semi-axes (a zero limit admits no force)."""
+    ratio = 0.0
+    for force, limit in ((force1, limit1), (force2, limit2)):
+        if limit <= 0.0:
+            if force != 0.0:
+                return True
+        else:
+            ratio += (force / limit) ** 2
+    return ratio > 1.0
