@@ -16,8 +16,8 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from .errors import ModelError
-from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotation_matrices,
-                       rotation_matrix)
+from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotate,
+                       rotation_matrices, rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
 from .wheel_contact import WheelContact
@@ -486,17 +486,30 @@ class Engine:
         mass = sum(self.client.getDynamicsInfo(robot.body, index)[0] for index in range(-1, robot.client.getNumJoints(
             robot.body)))
         contacts = []
+        driven_links = {robot.model.joints[joint].child for joint in driven_joints if joint in robot.model.joints}
         for link_name, (centre, axle) in wheels.items():
-            if link_name in robot.link_index:
-                mu1, mu2 = robot.model.links[link_name].surface(source)
-                contacts.append(WheelContact(self.client, robot.body, robot.link_index[link_name], centre, axle,
-                                             robot.model.fdir1(link_name, source), mu1, mu2, mass / len(wheels),
-                                             self.physics.max_step_size))
+            if link_name not in robot.link_index:
+                continue
+            index = robot.link_index[link_name]
+            mu1, mu2 = robot.model.links[link_name].surface(source)
+            share = mass / len(wheels)
+            along = share if link_name in driven_links else 1.0 / (
+                1.0 / share + robot.model.links[link_name].collision_radii[0] ** 2 / self._axle_inertia(
+                    robot.body, index, axle))
+            contacts.append(WheelContact(self.client, robot.body, index, centre, axle,
+                                         robot.model.fdir1(link_name, source), mu1, mu2, (along, share),
+                                         self.physics.max_step_size))
         for link_name, link in robot.model.links.items():
             if link.gazebo_tag("fdir1") is not None and link_name not in wheels:
                 warn_once(_logger, f"{robot.name}: link '{link_name}' <fdir1> acts on wheels only (cylinders about "
                                    "their joint's axis); ignored")
         self._set_wheels(robot.body, contacts)
+
+    def _axle_inertia(self, body: int, index: int, axle: Sequence[float]) -> float:
+        """A link's moment of inertia about an axis through its centre of mass along ``axle`` (its frame)."""
+        info = self.client.getDynamicsInfo(body, index)
+        inertial_axle = rotate(inverse(Pose((0.0, 0.0, 0.0), tuple(info[4]))).orientation, axle)
+        return max(sum(moment * value * value for moment, value in zip(info[2], inertial_axle)), 1e-12)
 
     def _set_wheels(self, body: int, contacts: List[WheelContact]):
         self._wheels[body] = contacts

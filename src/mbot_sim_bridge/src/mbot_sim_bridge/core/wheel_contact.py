@@ -12,7 +12,9 @@ step, at the contact moved along the axle to the wheel's mid-plane (where ODE's 
 Along ``fdir1`` (Gazebo's first friction direction, in the wheel's frame; the rolling direction when absent) the
 limit is mu1*N and across it mu2*N, on an ellipse (Coulomb's circle when mu1 = mu2). Below the limit the force
 opposes the slip in proportion, with a gain that takes a quarter of the slip away per step: a stiff but explicit
-stand-in for static friction, which Bullet's solver would give exactly.
+stand-in for static friction, which Bullet's solver would give exactly. The gain follows the mass the force
+moves: across the wheel, the wheel's share of the robot; along it, for a wheel no plugin drives, the wheel's own
+spin (a driven wheel's velocity motor holds its spin, so there the share of the robot again).
 """
 import math
 from typing import Optional, Sequence, Tuple
@@ -44,11 +46,14 @@ class WheelContact:
     """The friction of one wheel link (Bullet link ``index`` of ``body``) against whatever it touches."""
 
     def __init__(self, client, body: int, index: int, centre: Sequence[float], axis: Sequence[float],
-                 fdir1: Optional[Sequence[float]], mu1: float, mu2: float, mass_share: float, step_size: float):
+                 fdir1: Optional[Sequence[float]], mu1: float, mu2: float, masses: Tuple[float, float],
+                 step_size: float):
+        """``masses``: what a force at the tread moves along the rolling direction and across it (kg)."""
         self.client, self.body, self.index = client, body, index
         self.centre, self.axis, self.fdir1 = tuple(centre), tuple(axis), fdir1  # in the link frame
         self.mu1, self.mu2 = mu1, mu2
-        self.gain = STICK_FRACTION * mass_share / step_size  # N per m/s of slip, per contact point
+        # N per m/s of slip, along the rolling direction and across it, shared by the contact points.
+        self.gains = tuple(STICK_FRACTION * mass / step_size for mass in masses)
         self._surfaces = {}  # (body, link) -> (lateral friction, static)
 
     def _surface(self, body: int, link: int) -> Tuple[float, bool]:
@@ -81,7 +86,7 @@ class WheelContact:
         centre = (frame[0] + offset[0], frame[1] + offset[1], frame[2] + offset[2])
         axis = rotate(orientation, self.axis)
         fdir1 = rotate(orientation, self.fdir1) if self.fdir1 is not None else None
-        gain = self.gain / len(points)
+        gain_along, gain_across = (gain / len(points) for gain in self.gains)
         for point in points:
             other, other_link, normal, normal_force = point[2], point[4], point[7], point[9]
             friction, static = self._surface(other, other_link)
@@ -96,12 +101,17 @@ class WheelContact:
             if not static:
                 moving = self._velocity_of(other, other_link, at)
                 velocity = (velocity[0] - moving[0], velocity[1] - moving[1], velocity[2] - moving[2])
-            first = self._first_direction(fdir1, axis, normal)
-            if first is None:
+            rolling = _unit(_cross(axis, normal))
+            first = self._first_direction(fdir1, rolling, normal)
+            if rolling is None or first is None:
                 continue
             second = _cross(normal, first)
+            across = _cross(normal, rolling)
+            along_slip, across_slip = _dot(velocity, rolling), _dot(velocity, across)
+            stick = tuple(-gain_along * along_slip * rolling[i] - gain_across * across_slip * across[i]
+                          for i in range(3))
             slip1, slip2 = _dot(velocity, first), _dot(velocity, second)
-            force1, force2 = -gain * slip1, -gain * slip2
+            force1, force2 = _dot(stick, first), _dot(stick, second)
             if _outside(force1, force2, mu1 * normal_force, mu2 * normal_force):
                 # Sliding: the force on the ellipse that dissipates most (opposite the slip when mu1 = mu2).
                 weighted = math.hypot(mu1 * slip1, mu2 * slip2)
@@ -113,9 +123,11 @@ class WheelContact:
             client.applyExternalForce(self.body, self.index, force, at, pybullet.WORLD_FRAME)
 
     @staticmethod
-    def _first_direction(fdir1, axis, normal) -> Optional[Tuple[float, float, float]]:
-        """fdir1 in the contact plane, or the rolling direction (axle x normal) when fdir1 is absent or edge-on."""
-        for direction in ((fdir1,) if fdir1 is not None else ()) + (_cross(axis, normal),):
+    def _first_direction(fdir1, rolling, normal) -> Optional[Tuple[float, float, float]]:
+        """fdir1 in the contact plane, or the rolling direction when fdir1 is absent or edge-on."""
+        if fdir1 is None:
+            return rolling
+        for direction in (fdir1, rolling or (0.0, 0.0, 0.0)):
             along = _dot(direction, normal)
             unit = _unit((direction[0] - along * normal[0], direction[1] - along * normal[1],
                           direction[2] - along * normal[2]))
