@@ -1,9 +1,10 @@
 """Wheel and ground contact: lumped fixed-joint parts keep their own surface (a frictionless caster under a
-chassis with friction), and wheels get the wheel contact model (core/wheel_contact.py), so a ros_control
-differential base tracks its commands and skid-steer bases turn in place alike both ways, steadily, at any
-heading. Ground truth from the core's root pose. MBOT_LONG_TESTS=1 runs every turn over 10 s."""
+chassis with friction), wheels touch the ground at their mid-plane, and wheels that carry fdir1 get the wheel
+contact model (core/wheel_contact.py), so a ros_control differential base tracks its commands and skid-steer
+bases turn in place alike both ways, steadily, at any heading. Ground truth from the core's root pose. MBOT_LONG_TESTS=1 runs every turn over 10 s."""
 import math
 import os
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from mbot_sim_bridge.core.wheel_contact import _outside
 from mbot_sim_bridge.package_uris import resolve_package_uris
 
 LONG = os.environ.get("MBOT_LONG_TESTS") == "1"
+CASTER_CONTROL = os.path.join(ROBOTS, "config", "caster_control.yaml")
 HUSKY = {"wheel_radius": "0.1651", "wheel_width": "0.1143", "track": "0.5708", "wheelbase": "0.512",
          "base_mass": "46.034", "wheel_mass": "2.637"}
 
@@ -27,8 +29,7 @@ def caster_base_urdf():
 
 @pytest.fixture(scope="module")
 def caster_base():
-    sim, spawned, plugin = simulate(caster_base_urdf(), load_yaml(os.path.join(ROBOTS, "config", "caster_control.yaml")),
-                                    "caster_base", namespace="/")
+    sim, spawned, plugin = simulate(caster_base_urdf(), load_yaml(CASTER_CONTROL), "caster_base", namespace="/")
     controller = start_controllers(sim, plugin, "mobile_base_controller", "joint_state_controller")
     yield sim, spawned, controller
     sim.close()
@@ -41,8 +42,8 @@ def test_a_lumped_caster_keeps_its_own_surface_and_the_chassis_its_own(caster_ba
     assert "caster_link" not in robot.link_index  # Gazebo has no such link
     friction = {name: robot.client.getDynamicsInfo(robot.body, index)[1]
                 for name, index in {**robot.link_index, **robot.surface_link_index}.items()}
-    # The chassis (and the lidar lumped with it) keeps mu 1, the caster its 0; wheels are the wheel model's.
-    assert friction == {"base_link": 1.0, "caster_link": 0.0, "left_wheel_link": 0.0, "right_wheel_link": 0.0}
+    # The chassis (and the lidar lumped with it) keeps mu 1, the caster its 0; the wheels (no fdir1) Bullet's 1.
+    assert friction == {"base_link": 1.0, "caster_link": 0.0, "left_wheel_link": 1.0, "right_wheel_link": 1.0}
     names = sim.engine.collision_names[robot.body]
     assert names[robot.surface_link_index["caster_link"]] == \
         "caster_base::base_link::base_link_fixed_joint_lump__caster_link_collision"
@@ -162,13 +163,23 @@ def test_a_bad_mu_is_refused_in_one_line(mu):
         parse_robot(caster_base_urdf().replace("<mu1>0</mu1>", f"<mu1>{mu}</mu1>"), "model 'caster_base'")
 
 
+def test_only_wheels_with_fdir1_get_the_model_and_every_wheel_a_tread(caster_base, skid_base):
+    _, sim, spawned, _ = skid_base
+    assert sorted(sim.engine._wheels[spawned.robot.body].wheels) == sorted(
+        index for name, index in spawned.robot.link_index.items() if name.endswith("wheel_link"))
+    caster_sim, caster, _ = caster_base
+    assert caster.robot.body not in caster_sim.engine._wheels
+    treads = ElementTree.fromstring(caster.robot.model.pybullet_urdf).findall(
+        "link[@name='left_wheel_link']/collision/geometry/cylinder")
+    assert [(float(c.get("radius")), float(c.get("length"))) for c in treads] == [(0.05, 0.002), (0.0495, 0.03)]
+
+
 def test_a_huge_fdir1_is_a_direction_and_fdir1_off_a_wheel_is_said_once(caplog):
     urdf = caster_base_urdf().replace("<mu1>1</mu1>", "<mu1>1</mu1><fdir1>1e308 1e308 0</fdir1>", 1)
     urdf = urdf.replace("<mu1>0</mu1>", "<mu1>0</mu1><fdir1>1 0 0</fdir1>")
     model = parse_robot(urdf, "model 'caster_base'")
     assert model.fdir1("left_wheel_link", "x") == pytest.approx((math.sqrt(0.5), math.sqrt(0.5), 0.0))
-    sim, spawned, plugin = simulate(urdf, load_yaml(os.path.join(ROBOTS, "config", "caster_control.yaml")),
-                                    "caster_base", namespace="/")
+    sim, spawned, plugin = simulate(urdf, load_yaml(CASTER_CONTROL), "caster_base", namespace="/")
     sim.step(200)
     assert "link 'caster_link' <fdir1> acts on wheels only" in caplog.text
     assert all(math.isfinite(value) for value in spawned.robot.root_pose().position)

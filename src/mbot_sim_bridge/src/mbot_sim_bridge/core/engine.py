@@ -20,7 +20,7 @@ from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quatern
                        rotation_matrices, rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
 from .robot_model import RobotModel
-from .wheel_contact import WheelContact
+from .wheel_contact import WheelContacts, wheel
 from .world_description import PhysicsConfig
 from .world_bodies import LoadedWorld
 
@@ -263,7 +263,7 @@ class Engine:
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
-        self._wheels: Dict[int, List[WheelContact]] = {}  # per body, the friction of its wheels (wheel_contact)
+        self._wheels: Dict[int, WheelContacts] = {}  # per body, the friction of its wheels (wheel_contact)
         self._before_step: List[Callable[[], None]] = []
 
     def _configure(self):
@@ -297,8 +297,9 @@ class Engine:
         return self.steps * self.physics.max_step_size
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
-        """``count`` physics steps; each of ``after_each`` (recorders of per-step state, then the plugins that act
-        on every step) is called after every one, with ``sim_time`` already that step's."""
+        """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of
+        ``after_each`` (recorders of per-step state, then the plugins that act on every step) is called after
+        every one, with ``sim_time`` already that step's."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
         before = self._before_step
         if after_each or before:
@@ -373,7 +374,7 @@ class Engine:
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
         self.collision_names.pop(body, None)
-        self._set_wheels(body, [])
+        self._set_wheels(body, None)
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -462,7 +463,7 @@ class Engine:
                 urdf_file.write(model.pybullet_urdf)
             # Fixed joints come lumped (RobotModel), so PyBullet's URDF_MERGE_FIXED_LINKS is not asked for.
             flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
-            # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
+            # PyBullet's URDF importer prints what it does; keep it out of the node's output.
             with open(os.devnull, "w") as devnull, c_stdout_to(devnull):
                 body = self.client.loadURDF(path, flags=flags, useFixedBase=model.anchored)
         except pybullet.error as error:
@@ -479,31 +480,30 @@ class Engine:
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
             _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
-        wheels = robot.model.wheels
-        for link_name, index in {**robot.link_index, **robot.surface_link_index}.items():
-            self._set_surface(robot, link_name, index, caster=link_name in casters, wheel=link_name in wheels)
         source = f"model '{robot.name}'"
+        # The wheels that carry fdir1 get the wheel contact model; Gazebo's ODE too turns friction with them only.
+        modelled = {link_name: wheel_axle for link_name, wheel_axle in robot.model.wheels.items()
+                    if robot.model.fdir1(link_name, source) is not None and link_name in robot.link_index}
+        for link_name, index in {**robot.link_index, **robot.surface_link_index}.items():
+            self._set_surface(robot, link_name, index, caster=link_name in casters, modelled=link_name in modelled)
         mass = sum(self.client.getDynamicsInfo(robot.body, index)[0] for index in range(-1, robot.client.getNumJoints(
             robot.body)))
         contacts = []
         driven_links = {robot.model.joints[joint].child for joint in driven_joints if joint in robot.model.joints}
-        for link_name, (centre, axle) in wheels.items():
-            if link_name not in robot.link_index:
-                continue
+        for link_name, (centre, axle) in modelled.items():
             index = robot.link_index[link_name]
             mu1, mu2 = robot.model.links[link_name].surface(source)
-            share = mass / len(wheels)
+            share = mass / len(robot.model.wheels)
             along = share if link_name in driven_links else 1.0 / (
                 1.0 / share + robot.model.links[link_name].collision_radii[0] ** 2 / self._axle_inertia(
                     robot.body, index, axle))
-            contacts.append(WheelContact(self.client, robot.body, index, centre, axle,
-                                         robot.model.fdir1(link_name, source), mu1, mu2, (along, share),
-                                         self.physics.max_step_size))
+            contacts.append(wheel(index, centre, axle, robot.model.fdir1(link_name, source), mu1, mu2,
+                                  (along, share), self.physics.max_step_size))
         for link_name, link in robot.model.links.items():
-            if link.gazebo_tag("fdir1") is not None and link_name not in wheels:
+            if link.gazebo_tag("fdir1") is not None and link_name not in robot.model.wheels:
                 warn_once(_logger, f"{robot.name}: link '{link_name}' <fdir1> acts on wheels only (cylinders about "
                                    "their joint's axis); ignored")
-        self._set_wheels(robot.body, contacts)
+        self._set_wheels(robot.body, WheelContacts(self.client, robot.body, contacts) if contacts else None)
 
     def _axle_inertia(self, body: int, index: int, axle: Sequence[float]) -> float:
         """A link's moment of inertia about an axis through its centre of mass along ``axle`` (its frame)."""
@@ -511,17 +511,20 @@ class Engine:
         inertial_axle = rotate(inverse(Pose((0.0, 0.0, 0.0), tuple(info[4]))).orientation, axle)
         return max(sum(moment * value * value for moment, value in zip(info[2], inertial_axle)), 1e-12)
 
-    def _set_wheels(self, body: int, contacts: List[WheelContact]):
-        self._wheels[body] = contacts
-        self._before_step = [wheel.apply for wheels in self._wheels.values() for wheel in wheels]
+    def _set_wheels(self, body: int, contacts: Optional[WheelContacts]):
+        if contacts is None:
+            self._wheels.pop(body, None)
+        else:
+            self._wheels[body] = contacts
+        self._before_step = [wheels.apply for wheels in self._wheels.values()]
 
-    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, wheel: bool):
+    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, modelled: bool):
         mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")
-        if mu1 != mu2 and not wheel:
+        if mu1 != mu2 and not modelled:
             warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1:g} and mu2 {mu2:g}; Bullet's friction "
                                "is isotropic, the smaller is used")
         # A wheel's friction is the wheel contact model's (wheel_contact), not Bullet's.
-        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or wheel else min(mu1, mu2),
+        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or modelled else min(mu1, mu2),
                                    spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
 
     def _remember_initial_state(self, body: int):

@@ -5,8 +5,7 @@ Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
   offset; the lumping is done here rather than by PyBullet's URDF_MERGE_FIXED_LINKS because sdformat keeps each
   lumped collision's own surface, and Bullet has one friction per link: a lumped part whose surface differs
   from its holder's (a frictionless caster under a chassis) stays a Bullet link of its own on a fixed joint;
-- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia,
-  so it gets a negligible inertial in the URDF handed to PyBullet);
+- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia);
 - a link with no ``<inertial>`` on a moving joint is not simulated, together with its subtree (with a warning);
 - ``<gazebo reference="...">`` blocks are collected per link; model-level ``<gazebo>`` blocks carry plugins.
 """
@@ -47,8 +46,8 @@ TREAD_WIDTH = 0.002
 SIDE_CLEARANCE = 0.01
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
-# A negligible inertial for massless lumped links: PyBullet adds it to the parent, which leaves the
-# parent's mass and inertia unchanged to within rounding, as Gazebo's lumping does.
+# A negligible inertial for a Bullet link without mass (a massless root, a separate surface): PyBullet would
+# give it 1 kg and unit inertia.
 _NEGLIGIBLE_MASS = 1e-9
 _NEGLIGIBLE_INERTIA = 1e-12
 # Shapes no larger than the farthest a model may be placed (engine.MAX_POSITION, m).

@@ -17,11 +17,10 @@ moves: across the wheel, the wheel's share of the robot; along it, for a wheel n
 spin (a driven wheel's velocity motor holds its spin, so there the share of the robot again).
 """
 import math
-from typing import Optional, Sequence, Tuple
+from typing import NamedTuple, Optional, Sequence, Tuple
 
 import pybullet
 
-from .geometry import rotate
 
 # Fraction of the slip velocity one step's friction takes away below the limit (see the module docstring).
 STICK_FRACTION = 0.25
@@ -42,18 +41,39 @@ def _unit(a) -> Optional[Tuple[float, float, float]]:
     return None if length < _TINY else (a[0] / length, a[1] / length, a[2] / length)
 
 
-class WheelContact:
-    """The friction of one wheel link (Bullet link ``index`` of ``body``) against whatever it touches."""
+def _rotate(q, v) -> Tuple[float, float, float]:
+    """``v`` rotated by the unit quaternion ``q`` (x, y, z, w), written out: a PyBullet call per vector would cost
+    more than the arithmetic, and this runs for every wheel at every step."""
+    x, y, z, w = q
+    tx, ty, tz = 2.0 * (y * v[2] - z * v[1]), 2.0 * (z * v[0] - x * v[2]), 2.0 * (x * v[1] - y * v[0])
+    return (v[0] + w * tx + y * tz - z * ty, v[1] + w * ty + z * tx - x * tz, v[2] + w * tz + x * ty - y * tx)
 
-    def __init__(self, client, body: int, index: int, centre: Sequence[float], axis: Sequence[float],
-                 fdir1: Optional[Sequence[float]], mu1: float, mu2: float, masses: Tuple[float, float],
-                 step_size: float):
-        """``masses``: what a force at the tread moves along the rolling direction and across it (kg)."""
-        self.client, self.body, self.index = client, body, index
-        self.centre, self.axis, self.fdir1 = tuple(centre), tuple(axis), fdir1  # in the link frame
-        self.mu1, self.mu2 = mu1, mu2
-        # N per m/s of slip, along the rolling direction and across it, shared by the contact points.
-        self.gains = tuple(STICK_FRACTION * mass / step_size for mass in masses)
+
+class Wheel(NamedTuple):
+    """One wheel link (Bullet link ``index``); vectors in its link frame."""
+    index: int
+    centre: Tuple[float, float, float]
+    axis: Tuple[float, float, float]
+    fdir1: Optional[Tuple[float, float, float]]
+    mu1: float
+    mu2: float
+    gains: Tuple[float, float]  # N per m/s of slip along the rolling direction and across it
+
+
+def wheel(index: int, centre, axis, fdir1, mu1: float, mu2: float, masses: Tuple[float, float],
+          step_size: float) -> Wheel:
+    """``masses``: what a force at the tread moves along the rolling direction and across it (kg)."""
+    return Wheel(index, tuple(centre), tuple(axis), fdir1, mu1, mu2,
+                 tuple(STICK_FRACTION * mass / step_size for mass in masses))
+
+
+class WheelContacts:
+    """The friction of a robot's wheels against whatever they touch: ``apply`` before every step."""
+
+    def __init__(self, client, body: int, wheels: Sequence[Wheel]):
+        self.client, self.body = client, body
+        self.wheels = {wheel.index: wheel for wheel in wheels}
+        self.indices = list(self.wheels)
         self._surfaces = {}  # (body, link) -> (lateral friction, static)
 
     def _surface(self, body: int, link: int) -> Tuple[float, bool]:
@@ -75,22 +95,28 @@ class WheelContact:
         return (linear[0] + spin[0], linear[1] + spin[1], linear[2] + spin[2])
 
     def apply(self):
-        client = self.client
-        points = [point for point in client.getContactPoints(bodyA=self.body, linkIndexA=self.index)
-                  if point[2] != self.body and point[9] > 0.0]
-        if not points:
+        client, body, wheels = self.client, self.body, self.wheels
+        touching = {}
+        for point in client.getContactPoints(bodyA=body):
+            if point[3] in wheels and point[2] != body and point[9] > 0.0:
+                touching.setdefault(point[3], []).append(point)
+        if not touching:
             return
-        state = client.getLinkState(self.body, self.index, computeLinkVelocity=1)
+        indices = list(touching)
+        for index, state in zip(indices, client.getLinkStates(body, indices, computeLinkVelocity=1)):
+            self._apply(wheels[index], touching[index], state)
+
+    def _apply(self, wheel: Wheel, points, state):
         com, frame, orientation, linear, angular = state[0], state[4], state[5], state[6], state[7]
-        offset = rotate(orientation, self.centre)
+        offset = _rotate(orientation, wheel.centre)
         centre = (frame[0] + offset[0], frame[1] + offset[1], frame[2] + offset[2])
-        axis = rotate(orientation, self.axis)
-        fdir1 = rotate(orientation, self.fdir1) if self.fdir1 is not None else None
-        gain_along, gain_across = (gain / len(points) for gain in self.gains)
+        axis = _rotate(orientation, wheel.axis)
+        fdir1 = _rotate(orientation, wheel.fdir1) if wheel.fdir1 is not None else None
+        gain_along, gain_across = (gain / len(points) for gain in wheel.gains)
         for point in points:
             other, other_link, normal, normal_force = point[2], point[4], point[7], point[9]
             friction, static = self._surface(other, other_link)
-            mu1, mu2 = self.mu1 * friction, self.mu2 * friction
+            mu1, mu2 = wheel.mu1 * friction, wheel.mu2 * friction
             if mu1 <= 0.0 and mu2 <= 0.0:
                 continue
             arm = (point[5][0] - centre[0], point[5][1] - centre[1], point[5][2] - centre[2])
@@ -102,7 +128,7 @@ class WheelContact:
                 moving = self._velocity_of(other, other_link, at)
                 velocity = (velocity[0] - moving[0], velocity[1] - moving[1], velocity[2] - moving[2])
             rolling = _unit(_cross(axis, normal))
-            first = self._first_direction(fdir1, rolling, normal)
+            first = _first_direction(fdir1, rolling, normal)
             if rolling is None or first is None:
                 continue
             second = _cross(normal, first)
@@ -120,20 +146,20 @@ class WheelContact:
                 force1 = -normal_force * mu1 * mu1 * slip1 / weighted
                 force2 = -normal_force * mu2 * mu2 * slip2 / weighted
             force = tuple(force1 * first[i] + force2 * second[i] for i in range(3))
-            client.applyExternalForce(self.body, self.index, force, at, pybullet.WORLD_FRAME)
+            self.client.applyExternalForce(self.body, wheel.index, force, at, pybullet.WORLD_FRAME)
 
-    @staticmethod
-    def _first_direction(fdir1, rolling, normal) -> Optional[Tuple[float, float, float]]:
-        """fdir1 in the contact plane, or the rolling direction when fdir1 is absent or edge-on."""
-        if fdir1 is None:
-            return rolling
-        for direction in (fdir1, rolling or (0.0, 0.0, 0.0)):
-            along = _dot(direction, normal)
-            unit = _unit((direction[0] - along * normal[0], direction[1] - along * normal[1],
-                          direction[2] - along * normal[2]))
-            if unit is not None:
-                return unit
-        return None
+
+def _first_direction(fdir1, rolling, normal) -> Optional[Tuple[float, float, float]]:
+    """fdir1 in the contact plane, or the rolling direction when fdir1 is absent or edge-on."""
+    if fdir1 is None:
+        return rolling
+    for direction in (fdir1, rolling or (0.0, 0.0, 0.0)):
+        along = _dot(direction, normal)
+        unit = _unit((direction[0] - along * normal[0], direction[1] - along * normal[1],
+                      direction[2] - along * normal[2]))
+        if unit is not None:
+            return unit
+    return None
 
 
 def _outside(force1: float, force2: float, limit1: float, limit2: float) -> bool:
