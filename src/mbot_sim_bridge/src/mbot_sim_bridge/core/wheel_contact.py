@@ -1,20 +1,19 @@
 """Wheel-ground friction computed by the bridge: Coulomb friction in the wheel's own frame, at its mid-plane.
 
-Bullet gets two things wrong for wheels, and skid-steer bases show both:
-- a multibody's friction acts along two directions fixed by the contact normal alone (btPlaneSpace1), so on flat
-  ground along world x and y, each limited by mu*N: a wheel sliding diagonally gets up to 1.41 times the grip,
-  and a base turning in place speeds up and slows down with its heading (every 90 degrees);
-- a cylinder lying on a plane touches it at one rim point, which jumps between the two rims as the wheel tilts by
-  rounding: the track changes by the wheel's width (a Husky turned at 0.17 or 0.52 rad/s for 0.5).
-So a wheel (a link whose collisions are cylinders about its joint's axis) gets no Bullet friction; before every
-step each of its contacts gets the friction force computed here, from the normal force Bullet found at the last
-step, at the contact moved along the axle to the wheel's mid-plane (where ODE's two rim contacts average to).
-Along ``fdir1`` (Gazebo's first friction direction, in the wheel's frame; the rolling direction when absent) the
-limit is mu1*N and across it mu2*N, on an ellipse (Coulomb's circle when mu1 = mu2). Below the limit the force
-opposes the slip in proportion, with a gain that takes a quarter of the slip away per step: a stiff but explicit
-stand-in for static friction, which Bullet's solver would give exactly. The gain follows the mass the force
-moves: across the wheel, the wheel's share of the robot; along it, for a wheel no plugin drives, the wheel's own
-spin (a driven wheel's velocity motor holds its spin, so there the share of the robot again).
+A multibody's friction in Bullet acts along two directions fixed by the contact normal alone (btPlaneSpace1), so
+on flat ground along world x and y, each limited by mu*N: a wheel sliding diagonally gets up to 1.41 times the
+grip, and a skid-steer base turning in place speeds up and slows down with its heading (every 90 degrees). ODE
+does the same unless the wheel sets ``fdir1``, which turns the friction directions with the wheel. So a wheel (a
+link whose collisions are cylinders about its joint's axis; ``RobotModel.wheels``) that carries ``fdir1`` gets
+no Bullet friction: before every step each of its contacts gets the force computed here, from the normal force
+Bullet found at the last step, at the contact moved along the axle to the wheel's mid-plane (where Bullet's
+tread touches, see robot_model._with_treads). Along ``fdir1`` (in the wheel's frame, seen in the contact plane)
+the limit is mu1*N and across it mu2*N, on an ellipse (Coulomb's circle when mu1 = mu2; ODE's is a box).
+Below the limit the force opposes the slip in proportion, with a gain that takes a quarter of the slip away per
+step: a stiff but explicit stand-in for static friction, which Bullet's solver would give exactly. The gain
+follows the mass the force moves: across the wheel, the wheel's share of the robot; along it, for a wheel no
+plugin drives, the wheel's own spin (a driven wheel's velocity motor holds its spin, so there the share of the
+robot again).
 """
 import math
 from typing import NamedTuple, Optional, Sequence, Tuple
