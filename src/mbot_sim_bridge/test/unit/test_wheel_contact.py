@@ -1,7 +1,8 @@
 """Wheel and ground contact: lumped fixed-joint parts keep their own surface (a frictionless caster under a
 chassis with friction), wheels touch the ground at their mid-plane, and wheels that carry fdir1 get the wheel
 contact model (core/wheel_contact.py), so a ros_control differential base tracks its commands and skid-steer
-bases turn in place alike both ways, steadily, at any heading. Ground truth from the core's root pose. MBOT_LONG_TESTS=1 runs every turn over 10 s."""
+bases turn in place alike both ways, steadily, at any heading. Ground truth from the core's root pose.
+MBOT_LONG_TESTS=1 runs every turn over 10 s."""
 import math
 import os
 from xml.etree import ElementTree
