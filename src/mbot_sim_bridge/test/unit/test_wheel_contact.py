@@ -185,3 +185,20 @@ def test_a_huge_fdir1_is_a_direction_and_fdir1_off_a_wheel_is_said_once(caplog):
     assert "link 'caster_link' <fdir1> acts on wheels only" in caplog.text
     assert all(math.isfinite(value) for value in spawned.robot.root_pose().position)
     sim.close()
+
+
+@pytest.mark.parametrize("mu1, mu2", [("1e308", "1e308"), ("1e308", "0"), ("0", "1e-300")])
+def test_huge_and_tiny_wheel_friction_keeps_the_robot_finite(caplog, mu1, mu2):
+    urdf = caster_base_urdf().replace("<mu1>1</mu1>", f"<mu1>{mu1}</mu1><fdir1>1 0 0</fdir1>").replace(
+        "<mu2>1</mu2>", f"<mu2>{mu2}</mu2>")
+    sim, spawned, plugin = simulate(urdf, load_yaml(CASTER_CONTROL), "caster_base", namespace="/")
+    controller = start_controllers(sim, plugin, "mobile_base_controller")
+    speed, _ = measured_motion(sim, spawned, controller, 0.3, 0.8, settle=1.0, window=0.5)
+    # Not frozen back at its spawn pose by a NaN state: it drives (a wheel with mu 0 along fdir1 only slides).
+    assert "made its state NaN" not in caplog.text and all(
+        math.isfinite(value) for value in spawned.robot.root_pose().position)
+    assert speed > 0.1 or mu1 == "0"
+    assert sim.engine._wheels[spawned.robot.body].wheels
+    if mu1 == "1e308":
+        assert "a wheel's friction is taken as at most 1000" in caplog.text
+    sim.close()

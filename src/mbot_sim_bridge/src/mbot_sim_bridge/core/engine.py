@@ -30,6 +30,9 @@ _logger = get_logger(__name__)
 # so poses and velocities given from outside are refused past them.
 MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
+# A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
+# stay finite below it.
+MAX_WHEEL_MU = 1.0e3
 
 
 class CachingBulletClient(BulletClient):
@@ -493,6 +496,10 @@ class Engine:
         for link_name, (centre, axle) in modelled.items():
             index = robot.link_index[link_name]
             mu1, mu2 = robot.model.links[link_name].surface(source)
+            if max(mu1, mu2) > MAX_WHEEL_MU:
+                warn_once(_logger, f"{robot.name}: link '{link_name}' mu1 {mu1:g} / mu2 {mu2:g}: a wheel's friction "
+                                   f"is taken as at most {MAX_WHEEL_MU:g} (beyond, its force would overflow)")
+                mu1, mu2 = min(mu1, MAX_WHEEL_MU), min(mu2, MAX_WHEEL_MU)
             share = mass / len(robot.model.wheels)
             along = share if link_name in driven_links else 1.0 / (
                 1.0 / share + robot.model.links[link_name].collision_radii[0] ** 2 / self._axle_inertia(

@@ -136,7 +136,9 @@ class WheelContacts:
             stick = tuple(-gain_along * along_slip * rolling[i] - gain_across * across_slip * across[i]
                           for i in range(3))
             slip1, slip2 = _dot(velocity, first), _dot(velocity, second)
-            force1, force2 = _dot(stick, first), _dot(stick, second)
+            # A direction without friction (mu 0) takes no force; the other still sticks below its limit.
+            force1 = _dot(stick, first) if mu1 > 0.0 else 0.0
+            force2 = _dot(stick, second) if mu2 > 0.0 else 0.0
             if _outside(force1, force2, mu1 * normal_force, mu2 * normal_force):
                 # Sliding: the force on the ellipse that dissipates most (opposite the slip when mu1 = mu2).
                 weighted = math.hypot(mu1 * slip1, mu2 * slip2)
@@ -165,9 +167,8 @@ def _outside(force1: float, force2: float, limit1: float, limit2: float) -> bool
     """Whether (force1, force2) lies beyond the ellipse with these semi-axes (a zero limit admits no force)."""
     ratio = 0.0
     for force, limit in ((force1, limit1), (force2, limit2)):
-        if limit <= 0.0:
-            if force != 0.0:
-                return True
-        else:
+        if abs(force) > limit:  # beyond one semi-axis (or any force on a zero one); also keeps the ratio finite
+            return True
+        if limit > 0.0:
             ratio += (force / limit) ** 2
     return ratio > 1.0
