@@ -144,3 +144,8 @@ def test_a_mesh_that_is_not_a_regular_file_is_refused_unopened(tmp_path):
     os.mkfifo(fifo)
     with pytest.raises(ModelError, match="collision mesh '.*pipe.stl': not a regular file"):
         parse_robot(_mesh_robot(fifo, fifo), "model 'probe'")
+
+
+def test_named_materials_stay_for_the_visuals_that_refer_to_them():
+    urdf = robot('<material name="red"><color rgba="1 0 0 1"/></material>', link("a"))
+    assert '<material name="red"><color rgba="1 0 0 1" /></material>' in parse_robot(urdf).pybullet_urdf

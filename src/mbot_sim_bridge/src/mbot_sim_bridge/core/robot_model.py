@@ -602,6 +602,7 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
     _check_links(root, checked, document, source)
     elements = {element.get("name"): element for element in checked.findall("link")}
     robot = ElementTree.Element("robot", name=root.get("name") or "robot")
+    robot.extend(checked.findall("material"))  # the named colours visuals refer to
     holders = {}
     for name, (holder, _) in lumped_into.items():
         if holder == name and name in links:
