@@ -1,10 +1,11 @@
 """robot_description (URDF after xacro) -> what the simulator needs, the way Gazebo's URDF import sees it.
 
 Follows sdformat9's ``parser_urdf.cc`` where it matters for physics:
-- fixed joints are lumped into their parent (PyBullet does the same with URDF_MERGE_FIXED_LINKS), so each
-  URDF link maps to a simulated body link plus a fixed offset;
-- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia,
-  so it gets a negligible inertial in the URDF handed to PyBullet);
+- fixed joints are lumped into their parent, so each URDF link maps to a simulated body link plus a fixed
+  offset; the lumping is done here rather than by PyBullet's URDF_MERGE_FIXED_LINKS because sdformat keeps each
+  lumped collision's own surface, and Bullet has one friction per link: a lumped part whose surface differs
+  from its holder's (a frictionless caster under a chassis) stays a Bullet link of its own on a fixed joint;
+- a link with no ``<inertial>`` that gets lumped adds no mass (PyBullet would give it 1 kg and unit inertia);
 - a link with no ``<inertial>`` on a moving joint is not simulated, together with its subtree (with a warning);
 - ``<gazebo reference="...">`` blocks are collected per link; model-level ``<gazebo>`` blocks carry plugins.
 """
@@ -16,10 +17,13 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 from xml.etree import ElementTree
 
+import numpy as np
+
 from ..errors import ModelError
-from ..geometry import IDENTITY, Pose, compose
+from ..geometry import IDENTITY, Pose, compose, rotate, rotation_matrix, rpy
 from ..log import get_logger, warn_once
-from ..xml_values import XmlDocument, check_range, parse_floats, parse_xml, read_attribute_numbers, read_origin
+from ..xml_values import (XmlDocument, check_range, parse_float, parse_floats, parse_xml, read_attribute_numbers,
+                          read_origin)
 
 _logger = get_logger(__name__)
 
@@ -28,16 +32,22 @@ MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
 SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
 
 # <gazebo reference="link"> tags the bridge acts on.
-LINK_TAGS_USED = ("material", "mu1", "mu2", "sensor")
+LINK_TAGS_USED = ("material", "mu1", "mu2", "fdir1", "sensor")
 # Tags whose Gazebo default is what Bullet does anyway: only another value is reported (value -> default).
 LINK_TAGS_DEFAULT_ONLY = {"turnGravityOff": "false", "gravity": "true", "selfCollide": "false"}
 # Tags read by Gazebo's URDF import that have no Bullet counterpart here: one warning per tag and model.
-LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "fdir1", "laserRetro", "maxContacts", "dampingFactor",
+LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "laserRetro", "maxContacts", "dampingFactor",
                        "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
                        "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
                        "preserveFixedJoint", "disableFixedJointLumping")
-# A negligible inertial for massless lumped links: PyBullet adds it to the parent, which leaves the
-# parent's mass and inertia unchanged to within rounding, as Gazebo's lumping does.
+# A wheel's tread (m) and how much narrower in radius its sides are (a fraction): see _with_treads. The sides
+# stay off flat ground until the wheel leans by about 2 degrees.
+TREAD_WIDTH = 0.002
+SIDE_CLEARANCE = 0.01
+# Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
+DEFAULT_MU = 1.0
+# A negligible inertial for a Bullet link without mass (a massless root, a separate surface): PyBullet would
+# give it 1 kg and unit inertia.
 _NEGLIGIBLE_MASS = 1e-9
 _NEGLIGIBLE_INERTIA = 1e-12
 # Shapes no larger than the farthest a model may be placed (engine.MAX_POSITION, m).
@@ -59,13 +69,21 @@ class Link:
     gazebo: List[ElementTree.Element] = field(default_factory=list)
 
     def gazebo_tag(self, tag: str) -> Optional[str]:
-        """Text of the last ``<gazebo reference>`` child with this tag (later blocks win, as in sdformat)."""
+        """Value of the last ``<gazebo reference>`` child with this tag (later blocks win, as in sdformat), its
+        text or, as sdformat's URDF import also reads it, its ``value`` attribute (Clearpath's ``<mu1 value=""/>``)."""
         text = None
         for block in self.gazebo:
             child = block.find(tag)
-            if child is not None and child.text is not None:
-                text = child.text.strip()
+            if child is None:
+                continue
+            value = child.get("value") if child.get("value") is not None else child.text
+            if value is not None:
+                text = value.strip()
         return text
+
+    def surface(self, source: str) -> Tuple[float, float]:
+        """(mu1, mu2) of the link's collisions, each 1 when not given, as in SDF's <ode> friction."""
+        return tuple(_friction(self.gazebo_tag(tag), source, self.name, tag) for tag in ("mu1", "mu2"))
 
 
 @dataclass
@@ -103,6 +121,10 @@ class RobotModel:
     pybullet_urdf: str
     transmissions: List[ElementTree.Element]
     document: XmlDocument  # the parsed robot_description: line numbers for messages
+    # Lumped links simulated as a Bullet link of their own (on a fixed joint, massless) for their own surface.
+    separate_surfaces: Tuple[str, ...] = ()
+    # Links that roll (see _wheels): link -> (the first cylinder's centre, the unit axle), in the link frame.
+    wheels: Dict[str, Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = field(default_factory=dict)
 
     @property
     def anchored(self) -> bool:
@@ -122,6 +144,25 @@ class RobotModel:
         """Simulated link -> (sdformat's name, pose in that link's frame, half extents) of each collision it
         holds; a mesh's extents are unknown here and taken as zero (its origin stands for it)."""
         boxes: Dict[str, List[Tuple[str, Pose, Tuple[float, float, float]]]] = {}
+        for holder, _, name, pose, extents in self._collisions():
+            boxes.setdefault(holder, []).append((name, pose, extents))
+        return boxes
+
+    def bullet_collision_names(self) -> Dict[str, List[str]]:
+        """As ``collision_names``, by Bullet link: a separate surface's collisions are held by its own."""
+        names: Dict[str, List[str]] = {}
+        for holder, part, name, _, _ in self._collisions():
+            names.setdefault(part if part in self.separate_surfaces else holder, []).append(name)
+        return names
+
+    def bullet_surface(self, bullet_link: str, source: str) -> Tuple[float, float]:
+        """(mu1, mu2) of a Bullet link: a separate surface's own, else that of the collisions its holder keeps."""
+        if bullet_link in self.separate_surfaces:
+            return self.links[bullet_link].surface(source)
+        return _held_surface(bullet_link, self.links, self.lumped_into, source)
+
+    def _collisions(self):
+        """(holder, URDF link, sdformat's name, pose in the holder's frame, half extents) of every collision."""
         elements = {element.get("name"): element for element in self.document.root.findall("link")}
         for link in self.links.values():
             if link.name not in self.lumped_into or link.name not in elements:
@@ -131,8 +172,23 @@ class RobotModel:
             for index, collision in enumerate(elements[link.name].findall("collision")):
                 name = f"{prefix}_collision" + (f"_{index}" if index else "")
                 pose = compose(offset, read_origin(collision, self.document))
-                boxes.setdefault(holder, []).append((name, pose, _half_extents(collision.find("geometry"))))
-        return boxes
+                yield holder, link.name, name, pose, _half_extents(collision.find("geometry"))
+
+    def fdir1(self, link_name: str, source: str) -> Optional[Tuple[float, float, float]]:
+        """Gazebo's first friction direction of a link, in its frame, or None when absent or zero."""
+        text = self.links[link_name].gazebo_tag("fdir1")
+        if text is None:
+            return None
+        try:
+            direction = parse_floats(text, 3)
+        except ValueError as error:
+            raise ModelError(f"{source}: <gazebo reference='{link_name}'> <fdir1> '{text}': {error}") from None
+        largest = max(abs(value) for value in direction)
+        if largest == 0.0:
+            return None
+        # Scaled before it is squared, so that 1e308 stays finite.
+        length = math.sqrt(sum((value / largest) ** 2 for value in direction))
+        return tuple(value / largest / length for value in direction)
 
     def sensors(self) -> List[Tuple[str, ElementTree.Element]]:
         """(URDF link name, <sensor> element) for every sensor in the ``<gazebo reference>`` blocks."""
@@ -277,9 +333,79 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     transmissions = root.findall("transmission")
     dropped = _drop_massless_moving_links(links, joints, source)
     lumped_into = _lump_fixed_links(roots[0], links, joints)
-    pybullet_urdf = _pybullet_urdf(root, links, dropped, document, source)
+    separate = _separate_surfaces(links, lumped_into, source)
+    pybullet_urdf = _pybullet_urdf(root, links, joints, dropped, lumped_into, separate, document, source)
     _read_collision_radii(root, links, document)
-    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, pybullet_urdf, transmissions, document)
+    wheels = _wheels(root, links, joints, document)
+    return RobotModel(name, roots[0], links, joints, plugins, lumped_into, _with_treads(pybullet_urdf, wheels),
+                      transmissions, document, separate, wheels)
+
+
+def _wheels(root: ElementTree.Element, links, joints, document: XmlDocument):
+    """Links that roll: every collision a cylinder whose axis is the axis of the link's revolute or continuous
+    joint. Link -> (the first cylinder's centre, the unit axle), in the link frame."""
+    elements = {element.get("name"): element for element in root.findall("link")}
+    found = {}
+    for joint in joints.values():
+        collisions = elements[joint.child].findall("collision") if joint.child in elements else []
+        length = math.sqrt(sum(value * value for value in joint.axis))
+        if joint.type not in ("continuous", "revolute") or not collisions or length == 0.0:
+            continue
+        axle = tuple(value / length for value in joint.axis)
+        poses = [read_origin(collision, document) for collision in collisions]
+        if all(kind == "cylinder" and abs(sum(a * b for a, b in zip(rotate(pose.orientation, (0.0, 0.0, 1.0)), axle)))
+               > 0.999 for kind, pose in zip(links[joint.child].collision_kinds, poses)):
+            found[joint.child] = (poses[0].position, axle)
+    return found
+
+
+def _with_treads(urdf: str, wheels) -> str:
+    """Each wheel cylinder as Bullet gets it: a thin tread of its radius at its mid-plane, and the cylinder a
+    little narrower in radius for what the wheel's sides touch. Bullet lets a cylinder lying on a plane touch it
+    at one rim point, which jumps between the rims as rounding tilts the wheel; that shifted the load and the
+    track of a wheeled base by half the wheel's width (see wheel_contact)."""
+    if not wheels:
+        return urdf
+    robot = ElementTree.fromstring(urdf)
+    for link in robot.findall("link"):
+        if link.get("name") not in wheels:
+            continue
+        for collision in link.findall("collision"):
+            cylinder = collision.find("geometry/cylinder")
+            radius, length = float(cylinder.get("radius")), float(cylinder.get("length"))
+            if length <= TREAD_WIDTH:
+                continue
+            tread = copy.deepcopy(collision)
+            tread.find("geometry/cylinder").set("length", repr(TREAD_WIDTH))
+            link.insert(list(link).index(collision), tread)
+            cylinder.set("radius", repr(radius * (1.0 - SIDE_CLEARANCE)))
+    return ElementTree.tostring(robot, encoding="unicode")
+
+
+def _friction(text: Optional[str], source: str, link: str, tag: str) -> float:
+    if text is None:
+        return DEFAULT_MU
+    try:
+        value = parse_float(text)
+        check_range(value, minimum=0.0)
+    except ValueError as error:
+        raise ModelError(f"{source}: <gazebo reference='{link}'> <{tag}> '{text}': {error}") from None
+    return value
+
+
+def _held_surface(holder: str, links, lumped_into, source: str) -> Tuple[float, float]:
+    """The surface a simulated link keeps: its own if it has collisions, else that of the first lumped link with
+    collisions (a base_link lumped into a collision-free base_footprint root keeps its mu)."""
+    parts = [name for name, (body, _) in lumped_into.items() if body == holder and links[name].collision_kinds]
+    first = holder if holder in parts or not parts else parts[0]
+    return links[first].surface(source)
+
+
+def _separate_surfaces(links, lumped_into, source: str) -> Tuple[str, ...]:
+    """Lumped links with collisions whose surface differs from the one their holder keeps."""
+    return tuple(name for name, (holder, _) in lumped_into.items()
+                 if holder != name and links[name].collision_kinds
+                 and links[name].surface(source) != _held_surface(holder, links, lumped_into, source))
 
 
 def _read_collision_radii(root: ElementTree.Element, links: Dict[str, Link], document: XmlDocument):
@@ -467,29 +593,112 @@ def _check_inertial(inertial: Optional[ElementTree.Element], document: XmlDocume
             raise ModelError(f"{where}: <inertia {name}>: {error}") from None
 
 
-def _pybullet_urdf(root: ElementTree.Element, links, dropped: List[str], document: XmlDocument,
-                   source: str) -> str:
-    """The URDF handed to PyBullet: no <gazebo>/<transmission>, dropped links removed, massless links weightless,
-    shapes, origins and inertials checked."""
-    original, root = root, copy.deepcopy(root)
-    _check_links(original, root, document, source)
-    for element in list(root):
-        if element.tag in ("gazebo", "transmission"):
-            root.remove(element)
-        elif element.tag == "link" and element.get("name") in dropped:
-            root.remove(element)
-        elif element.tag == "joint" and element.find("child").get("link") in dropped:
-            root.remove(element)
-    for element in root.findall("link"):
-        if links[element.get("name")].has_inertial:
+def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str], lumped_into, separate,
+                   document: XmlDocument, source: str) -> str:
+    """The URDF handed to PyBullet: fixed joints lumped as Gazebo does (masses, visuals and collisions moved into
+    the holder, a separate surface kept on a massless link of its own), no <gazebo>/<transmission>, dropped
+    links removed, shapes, origins and inertials checked."""
+    checked = copy.deepcopy(root)
+    _check_links(root, checked, document, source)
+    elements = {element.get("name"): element for element in checked.findall("link")}
+    robot = ElementTree.Element("robot", name=root.get("name") or "robot")
+    robot.extend(checked.findall("material"))  # the named colours visuals refer to
+    holders = {}
+    for name, (holder, _) in lumped_into.items():
+        if holder == name and name in links:
+            holders[name] = ElementTree.SubElement(robot, "link", name=name)
+    masses = {holder: [] for holder in holders}
+    for name, (holder, offset) in lumped_into.items():
+        if name not in links:
             continue
-        for stale in element.findall("inertial"):
-            element.remove(stale)
-        inertial = ElementTree.SubElement(element, "inertial")
-        ElementTree.SubElement(inertial, "mass", value=repr(_NEGLIGIBLE_MASS))
-        ElementTree.SubElement(inertial, "inertia", ixx=repr(_NEGLIGIBLE_INERTIA), iyy=repr(_NEGLIGIBLE_INERTIA),
+        element = elements[name]
+        for visual in element.findall("visual"):
+            _move(visual, offset, document)
+            holders[holder].append(visual)
+        if name in separate:
+            # Its fixed joint's origin is the offset: the collisions keep their own origins.
+            own = ElementTree.SubElement(robot, "link", name=name)
+            _add_inertial(own, [])
+            parent_joint = next(joint for joint in joints.values() if joint.child == name)
+            _add_joint(robot, parent_joint.name, "fixed", holder, name, offset)
+            own.extend(element.findall("collision"))
+        else:
+            for collision in element.findall("collision"):
+                _move(collision, offset, document)
+                holders[holder].append(collision)
+        inertial = element.find("inertial")
+        if links[name].has_inertial and inertial is not None:
+            masses[holder].append((inertial, offset))
+    for holder, parts in masses.items():
+        _add_inertial(holders[holder], parts, document)
+    for joint in joints.values():
+        if joint.type == "fixed" or joint.child in dropped:
+            continue
+        element = copy.deepcopy(next(e for e in checked.findall("joint") if e.get("name") == joint.name))
+        holder, offset = lumped_into[joint.parent]
+        element.find("parent").set("link", holder)
+        _move(element, offset, document)
+        robot.append(element)
+    return ElementTree.tostring(robot, encoding="unicode")
+
+
+def _move(element: ElementTree.Element, offset: Pose, document: XmlDocument):
+    """``element``'s <origin> seen from ``offset``'s parent frame; left as written for the identity (PyBullet's
+    transforms round to single precision)."""
+    if offset != IDENTITY:
+        _set_origin(element, compose(offset, read_origin(element, document)))
+
+
+def _set_origin(element: ElementTree.Element, pose: Pose):
+    for stale in element.findall("origin"):
+        element.remove(stale)
+    origin = ElementTree.Element("origin", xyz=" ".join(repr(v) for v in pose.position),
+                                 rpy=" ".join(repr(v) for v in rpy(pose.orientation)))
+    element.insert(0, origin)
+
+
+def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, child: str, origin: Pose):
+    joint = ElementTree.SubElement(robot, "joint", name=name, type=kind)
+    ElementTree.SubElement(joint, "parent", link=parent)
+    ElementTree.SubElement(joint, "child", link=child)
+    _set_origin(joint, origin)
+
+
+def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocument] = None):
+    """The combined inertial of ``parts`` ((<inertial>, pose of its link in ``link``'s frame)) about their common
+    centre of mass, as sdformat lumps fixed joints; a negligible one when there is no mass (PyBullet would give
+    1 kg and unit inertia)."""
+    total, centre, tensor = 0.0, np.zeros(3), np.zeros((3, 3))
+    placed = []
+    for inertial, offset in parts:
+        mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
+        pose = compose(offset, read_origin(inertial, document))
+        values = {name: 0.0 for name in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+        if inertial.find("inertia") is not None:
+            values = {name: read_attribute_numbers(inertial.find("inertia"), name, document, (0.0,), 1)[0]
+                      for name in values}
+        local = np.array([[values["ixx"], values["ixy"], values["ixz"]], [values["ixy"], values["iyy"], values["iyz"]],
+                          [values["ixz"], values["iyz"], values["izz"]]])
+        rotation = np.array(rotation_matrix(pose.orientation))
+        placed.append((mass, np.array(pose.position), rotation @ local @ rotation.T))
+        total += mass
+        centre += mass * np.array(pose.position)
+    element = ElementTree.SubElement(link, "inertial")
+    if total <= 0.0:
+        ElementTree.SubElement(element, "mass", value=repr(_NEGLIGIBLE_MASS))
+        ElementTree.SubElement(element, "inertia", ixx=repr(_NEGLIGIBLE_INERTIA), iyy=repr(_NEGLIGIBLE_INERTIA),
                                izz=repr(_NEGLIGIBLE_INERTIA), ixy="0", ixz="0", iyz="0")
-    return ElementTree.tostring(root, encoding="unicode")
+        return
+    centre /= total
+    for mass, position, rotated in placed:
+        arm = position - centre
+        tensor += rotated + mass * (arm @ arm * np.eye(3) - np.outer(arm, arm))
+    # Products far below the moments are rounding; PyBullet would turn them into a tiny rotation of the frame.
+    tensor[np.abs(tensor) < 1e-12 * max(np.trace(tensor), _NEGLIGIBLE_INERTIA)] = 0.0
+    ElementTree.SubElement(element, "origin", xyz=" ".join(repr(float(v)) for v in centre), rpy="0 0 0")
+    ElementTree.SubElement(element, "mass", value=repr(total))
+    ElementTree.SubElement(element, "inertia", **{name: repr(float(tensor[i, j])) for name, (i, j) in (
+        ("ixx", (0, 0)), ("iyy", (1, 1)), ("izz", (2, 2)), ("ixy", (0, 1)), ("ixz", (0, 2)), ("iyz", (1, 2)))})
 
 
 def _half_extents(geometry: Optional[ElementTree.Element]) -> Tuple[float, float, float]:

@@ -23,10 +23,13 @@ from typing import Optional
 from .. import names
 from ..clock import UpdateTimer
 from ..geometry import pose_from_xyz_rpy
+from ..log import get_logger, warn_once
 from ..params import Param, non_negative, positive
 from ..plugin import Plugin
 from ..ros_control.hardware_interface import UNBOUNDED_EFFORT
 from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
+
+_logger = get_logger(__name__)
 
 JOINT_TAGS = ("steeringJoint", "actuatedWheelJoint", "encoderWheelLeftJoint", "encoderWheelRightJoint")
 ODOMETRY_SOURCES = ("world", "encoder")
@@ -99,6 +102,11 @@ class TricycleDrive(TwistCommand, Plugin):
         x, y, heading = self.encoder_pose
         mean = (left_distance + right_distance) / 2.0
         turn = (left_distance - right_distance) / separation
+        if not all(math.isfinite(value) for value in (x + mean, y + mean, heading + turn)):
+            warn_once(_logger, f"{self.label}: the encoder odometry overflows (encoderWheelDiameter "
+                               f"{self.params['encoderWheelDiameter']:g}, encoderWheelSeparation {separation:g}); "
+                               "it stays at its last finite pose")
+            return
         dx = mean * math.cos(heading + turn / 2.0)
         dy = mean * math.sin(heading + turn / 2.0)
         self.encoder_pose = (x + dx, y + dy, heading + turn)

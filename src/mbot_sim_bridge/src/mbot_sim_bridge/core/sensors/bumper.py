@@ -95,7 +95,9 @@ class Bumper(Plugin):
         centre = np.asarray(centre)
         link_pose = robot.link_world_pose(self.link)
         pairs = {}
-        for point in client.getContactPoints(bodyA=robot.body, linkIndexA=self.link_index):
+        points = [point for index in robot.bullet_links(self.link)
+                  for point in client.getContactPoints(bodyA=robot.body, linkIndexA=index)]
+        for point in points:
             body, link = point[2], point[4]
             if body == robot.body:
                 continue  # Gazebo's robots do not self-collide by default
