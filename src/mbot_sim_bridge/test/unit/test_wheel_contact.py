@@ -10,7 +10,8 @@ from xml.etree import ElementTree
 import numpy as np
 import pytest
 import xacro_noetic as xacro
-from ros_control_fixtures import ROBOTS, WORKSPACE_SRC, load_yaml, measured_motion, simulate, start_controllers
+from ros_control_fixtures import ROBOTS, WORKSPACE_SRC, load_yaml, simulate, start_controllers
+from sensor_fixtures import measured_motion
 
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import rpy, yaw
@@ -64,7 +65,7 @@ def test_lumped_parts_keep_the_mass_where_gazebo_puts_it(caster_base):
 @pytest.mark.parametrize("linear, angular", [(0.3, 0.0), (-0.2, 0.0), (0.0, 0.8), (0.0, -0.8)])
 def test_the_caster_base_tracks_within_5_percent_and_stays_level(caster_base, linear, angular):
     sim, spawned, controller = caster_base
-    speed, yaw_rate = measured_motion(sim, spawned, controller, linear, angular)
+    speed, yaw_rate = measured_motion(sim, spawned, lambda: controller.set_command(linear, angular, sim.sim_time))
     roll, pitch, _ = rpy(spawned.robot.root_pose().orientation)
     print(f"figure: caster base ({linear} m/s, {angular} rad/s) -> ({speed:.4f} m/s, {yaw_rate:.4f} rad/s), "
           f"tilt {math.degrees(math.hypot(roll, pitch)):.3f} deg")
@@ -104,7 +105,8 @@ def skid_base(request):
 
 def turn_windows(sim, spawned, controller, linear, angular, seconds):
     """Ground-truth yaw rates over consecutive 1 s windows after 1.5 s at the command, and the mean speed."""
-    measured_motion(sim, spawned, controller, linear, angular, settle=1.5, window=0.05)
+    measured_motion(sim, spawned, lambda: controller.set_command(linear, angular, sim.sim_time), settle=1.5,
+                    window=0.05)
     yaws, speeds = [yaw(spawned.robot.root_pose().orientation)], []
     for step in range(int(seconds * 20)):
         controller.set_command(linear, angular, sim.sim_time)
@@ -193,7 +195,8 @@ def test_huge_and_tiny_wheel_friction_keeps_the_robot_finite(caplog, mu1, mu2):
         "<mu2>1</mu2>", f"<mu2>{mu2}</mu2>")
     sim, spawned, plugin = simulate(urdf, load_yaml(CASTER_CONTROL), "caster_base", namespace="/")
     controller = start_controllers(sim, plugin, "mobile_base_controller")
-    speed, _ = measured_motion(sim, spawned, controller, 0.3, 0.8, settle=1.0, window=0.5)
+    speed, _ = measured_motion(sim, spawned, lambda: controller.set_command(0.3, 0.8, sim.sim_time), settle=1.0,
+                               window=0.5)
     # Not frozen back at its spawn pose by a NaN state: it drives (a wheel with mu 0 along fdir1 only slides).
     assert "made its state NaN" not in caplog.text and all(
         math.isfinite(value) for value in spawned.robot.root_pose().position)
