@@ -18,6 +18,8 @@ WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".
 WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
 MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
 ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
+CAR = os.path.join(WORKSPACE_SRC, "car_description", "urdf", "car.urdf.xacro")
+CAR_CONFIG = os.path.join(WORKSPACE_SRC, "car_gazebo", "config", "car_{}_controllers.yaml")
 
 
 def load_yaml(path):
@@ -78,6 +80,18 @@ def expand_xacro_arm(interface):
     import xacro_noetic as xacro
     return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
                               mappings={"interface": interface}).toxml()
+
+
+def expand_xacro_car(steering):
+    import xacro_noetic as xacro
+    return xacro.process_file(CAR, mappings={"steering": steering}).toxml()
+
+
+def car(steering):
+    """car_gazebo's car with ``steering`` (ackermann or four_wheel), its car_controller started."""
+    sim, spawned, plugin = simulate(expand_xacro_car(steering), load_yaml(CAR_CONFIG.format(steering)), "car",
+                                    namespace="/")
+    return sim, spawned, plugin, start_controllers(sim, plugin, "car_controller", "joint_state_controller")
 
 
 def arm(interface):

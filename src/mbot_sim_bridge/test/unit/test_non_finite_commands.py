@@ -9,13 +9,14 @@ import pytest
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control.controller_table import CORE_CONTROLLERS
-from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
+from mbot_sim_bridge.core.ros_control.diff_drive_controller import TwistController
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (JointTrajectory, JointTrajectoryController,
                                                                           TrajectoryPoint)
 
 from conftest import expand_xacro
-from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, start_controllers
+from ros_control_fixtures import (CAR_CONFIG, MBOT_YAML, ROBOTS, expand_xacro_arm, expand_xacro_car, load_yaml,
+                                  simulate, start_controllers)
 
 BYSTANDER_TOLERANCE = 1e-3  # m
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
@@ -55,6 +56,8 @@ COMMANDED = {
                                                                    "shoulder": {"pid": ARM_PID},
                                                                    "elbow": {"pid": ARM_PID}}),
     "diff_drive_controller/DiffDriveController": ("mbot", load_yaml(MBOT_YAML)["mobile_base_controller"]),
+    "ackermann_steering_controller/AckermannSteeringController":
+        ("ackermann", load_yaml(CAR_CONFIG.format("ackermann"))["car_controller"]),
     "position_controllers/JointTrajectoryController": ("Position", {"joints": ["shoulder", "elbow"]}),
     "velocity_controllers/JointTrajectoryController": ("Velocity", {"joints": ["shoulder", "elbow"],
                                                                     "gains": {"shoulder": {"p": 20.0},
@@ -72,7 +75,7 @@ def test_every_commanded_controller_type_is_fuzzed():
 
 def command(sim, controller, value):
     """``value`` for every joint, as the controller's command topic would carry it; the refusal, if any."""
-    if isinstance(controller, DiffDriveController):
+    if isinstance(controller, TwistController):
         return controller.set_command(value, value, sim.sim_time)
     if isinstance(controller, JointTrajectoryController):
         controller.command(JointTrajectory(controller.joint_names,
@@ -89,10 +92,14 @@ def command(sim, controller, value):
 @pytest.mark.parametrize("controller_type", sorted(COMMANDED))
 def test_non_finite_and_huge_commands_disturb_no_other_model(mbot_ros_control_urdf, controller_type, caplog):
     robot, config = COMMANDED[controller_type]
-    urdf = mbot_ros_control_urdf if robot == "mbot" else expand_xacro_arm(robot)
-    name = "mbot" if robot == "mbot" else "arm"
+    if robot == "mbot":
+        urdf, name = mbot_ros_control_urdf, "mbot"
+    elif robot in ("ackermann", "four_wheel"):
+        urdf, name = expand_xacro_car(robot), "car"
+    else:
+        urdf, name = expand_xacro_arm(robot), "arm"
     sim, spawned, plugin = simulate(urdf, {"fuzzed": dict(config, type=controller_type)}, name,
-                                    namespace="/" if robot == "mbot" else None)  # the mbot's robotNamespace
+                                    namespace=None if name == "arm" else "/")  # the others' robotNamespace
     try:
         resting = with_bystander(sim, mbot_ros_control_urdf)
         controller = start_controllers(sim, plugin, "fuzzed")

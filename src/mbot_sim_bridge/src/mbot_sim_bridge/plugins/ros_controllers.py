@@ -25,7 +25,7 @@ from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from ..core.ros_control.controller_table import CORE_CONTROLLERS
-from ..core.ros_control.diff_drive_controller import CommandSample, DiffDriveController, OdometrySample
+from ..core.ros_control.diff_drive_controller import CommandSample, OdometrySample, TwistController
 from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.ros_control.joint_trajectory_controller import (ABORTED, SUCCEEDED, JointTolerance, JointTrajectory,
@@ -58,7 +58,9 @@ class RosJointStateController(JointStateController):
         self.publisher.unregister()
 
 
-class RosDiffDriveController(DiffDriveController):
+class RosTwistController(TwistController):
+    """cmd_vel in, odom and the odom TF out (and cmd_vel_out for the diff drive's ``publish_cmd``)."""
+
     def __init__(self, name, hw, params, context):
         super().__init__(name, hw, params, context)
         self.clock = context.clock
@@ -289,7 +291,7 @@ def _ros_class(core_class: type) -> type:
 
 def _ros_controller(core_class: type) -> type:
     for core_base, ros_class in ((JointStateController, RosJointStateController),
-                                 (DiffDriveController, RosDiffDriveController),
+                                 (TwistController, RosTwistController),
                                  (JointTrajectoryController, RosJointTrajectoryController),
                                  (GripperActionController, RosGripperActionController)):
         if core_class is core_base:

@@ -5,6 +5,7 @@ Its own module, not the package's ``__init__``: a robot without ros_control (who
 """
 from typing import Dict
 
+from .ackermann_steering_controller import AckermannSteeringController
 from .diff_drive_controller import DiffDriveController
 from .gripper_action_controller import GripperActionController
 from .forward_command_controller import ForwardCommandController, ForwardJointGroupCommandController, forward_type
@@ -17,6 +18,7 @@ from .pid_controllers import EffortGroupPositionController, EffortVelocityContro
 CORE_CONTROLLERS: Dict[str, type] = {
     "joint_state_controller/JointStateController": JointStateController,
     "diff_drive_controller/DiffDriveController": DiffDriveController,
+    "ackermann_steering_controller/AckermannSteeringController": AckermannSteeringController,
     "velocity_controllers/JointPositionController":
         type("VelocityJointPositionController", (PidPositionController,), {"INTERFACE": VELOCITY}),
     "effort_controllers/JointPositionController":
