@@ -1,0 +1,1 @@
+"""The plugins that push and hold things: a wrench topic on a link (force)."""
