@@ -1,1 +1,1 @@
-"""The plugins that push and hold things: a wrench topic on a link (force)."""
+"""The plugins that push and hold things: a wrench topic on a link (force), the vacuum gripper."""
