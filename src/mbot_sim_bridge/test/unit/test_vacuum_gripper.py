@@ -88,5 +88,5 @@ def test_out_of_reach_nothing_is_pulled_and_the_services_say_so(tmp_path):
 
 
 def test_a_missing_link_refuses_the_spawn(tmp_path):
-    with pytest.raises(ConfigError, match="link named: suction_cup does not exist"):
+    with pytest.raises(ConfigError, match="bodyName: link named: suction_cup does not exist"):
         spawn(tmp_path, body="suction_cup")

@@ -60,6 +60,16 @@ class RosJointStateController(JointStateController):
         self.publisher.unregister()
 
 
+def advertise_odometry(controller, context) -> str:
+    """A base controller's clock, frames, ``odom`` and /tf publishers; its namespace."""
+    controller.clock = context.clock
+    controller.odom_frame = resolve_frame(controller.odom_frame_id)
+    controller.base_frame = resolve_frame(controller.base_frame_id)
+    controller.odom_publisher = loop_publisher(context.namespace + "/odom", Odometry)
+    controller.tf_publisher = loop_publisher("/tf", TFMessage)
+    return context.namespace
+
+
 def publish_odometry(controller, stamp, odometry, linear_x: float, linear_y: float):
     """A base controller's nav_msgs/Odometry on ``odom`` and, with ``enable_odom_tf``, the odom TF."""
     message = Odometry()
@@ -88,11 +98,7 @@ class RosTwistController(TwistController):
 
     def __init__(self, name, hw, params, context):
         super().__init__(name, hw, params, context)
-        self.clock = context.clock
-        namespace = context.namespace
-        self.odom_frame, self.base_frame = resolve_frame(self.odom_frame_id), resolve_frame(self.base_frame_id)
-        self.odom_publisher = loop_publisher(namespace + "/odom", Odometry)
-        self.tf_publisher = loop_publisher("/tf", TFMessage)
+        namespace = advertise_odometry(self, context)
         self.cmd_publisher = loop_publisher(namespace + "/cmd_vel_out", TwistStamped) if self.publish_cmd else None
         self.subscriber = TrackedSubscriber(namespace + "/cmd_vel", Twist, self._on_command)
 
@@ -124,12 +130,8 @@ class RosFourWheelSteeringController(FourWheelSteeringController):
 
     def __init__(self, name, hw, params, context):
         super().__init__(name, hw, params, context)
-        self.clock = context.clock
-        namespace = context.namespace
-        self.odom_frame, self.base_frame = resolve_frame(self.odom_frame_id), resolve_frame(self.base_frame_id)
-        self.odom_publisher = loop_publisher(namespace + "/odom", Odometry)
+        namespace = advertise_odometry(self, context)
         self.steering_publisher = loop_publisher(namespace + "/odom_steer", FourWheelSteeringStamped)
-        self.tf_publisher = loop_publisher("/tf", TFMessage)
         self.subscribers = [TrackedSubscriber(namespace + "/cmd_vel", Twist, self._on_twist),
                             TrackedSubscriber(namespace + "/cmd_four_wheel_steering", FourWheelSteering,
                                               self._on_steering)]

@@ -12,10 +12,10 @@ from typing import Optional, Sequence
 from .. import names
 from ..body_wrenches import MAX_WRENCH, ZERO
 from ..clock import UpdateTimer
-from ..errors import ConfigError
 from ..log import get_logger, warn_once
 from ..params import Param
 from ..plugin import Plugin
+from . import body_link
 
 _logger = get_logger(__name__)
 
@@ -35,12 +35,7 @@ class Force(Plugin):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         self.params = self.read_params()
-        self.link = self.params["bodyName"]
-        links = context.robot.link_index
-        if self.link not in links:
-            raise ConfigError(f"{context.where(element)}: {self.label}: bodyName: link named: {self.link} does not "
-                              f"exist in model '{context.model.name}' (links after lumping fixed joints: "
-                              f"{', '.join(sorted(links))})")
+        self.link = body_link(self)
         self.timer = UpdateTimer(1e-12, strict=True, start=context.simulation.sim_time)  # nothing to publish
         self.force, self.torque = ZERO, ZERO
 

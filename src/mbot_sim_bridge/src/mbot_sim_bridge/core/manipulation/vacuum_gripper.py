@@ -15,11 +15,11 @@ from typing import Tuple
 from .. import names
 from ..body_wrenches import ZERO
 from ..clock import UpdateTimer
-from ..errors import ConfigError
 from ..geometry import Pose, rotate
 from ..log import get_logger
 from ..params import Param
 from ..plugin import Plugin
+from . import body_link
 from ..sensors.body_sensors import IDLE_PERIOD
 
 _logger = get_logger(__name__)
@@ -40,12 +40,7 @@ class VacuumGripper(Plugin):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         self.params = self.read_params()
-        self.link = self.params["bodyName"]
-        links = context.robot.link_index
-        if self.link not in links:
-            raise ConfigError(f"{context.where(element)}: {self.label}: link named: {self.link} does not exist "
-                              "(it must not hang on a fixed joint); found links are: "
-                              f"{', '.join(sorted(links))}")
+        self.link = body_link(self)
         self.timer = UpdateTimer(0.0, start=context.simulation.sim_time)
         self.on = False
         self.grasping = False

@@ -170,14 +170,13 @@ def _covariance_diagonal(params: dict, key: str, name: str) -> List[float]:
     return [float(v) for v in value]
 
 
-class TwistController(Controller):
-    """What ros_controllers' cmd_vel-driven bases share (diff drive, Ackermann steering): the odometry's publish
-    rate, ``open_loop``, rolling window, frames and covariances, ``cmd_vel_timeout``, the publishers' check and
-    the linear/angular speed limiters, as each reads them."""
+class OdometryController(Controller):
+    """What ros_controllers' wheeled bases share (diff drive, Ackermann and four-wheel steering): the odometry's
+    publish rate and rolling window, ``cmd_vel_timeout``, the base frame, ``enable_odom_tf``, the covariances and
+    the linear/angular speed limiters, as each reads them; braking on start and stop."""
     INTERFACE = VELOCITY
-    publish_cmd = False  # cmd_vel_out, the diff drive's option
 
-    def __init__(self, name, hw, params, context, odometry: "DiffDriveOdometry"):
+    def __init__(self, name, hw, params, context, odometry):
         super().__init__(name, hw, params, context)
 
         def get(key, default, kind=float):
@@ -186,36 +185,23 @@ class TwistController(Controller):
         if math.isnan(self.publish_rate) or self.publish_rate == 0:  # upstream's Duration(1 / rate) throws
             raise ControllerInitError(f"publish_rate {self.publish_rate} gives no publish period; it must be a "
                                       "number other than 0")
-        self.open_loop = get("open_loop", False, bool)
         odometry.window = get("velocity_rolling_window_size", 10, int)
         self.odometry = odometry
         self.cmd_vel_timeout = get("cmd_vel_timeout", 0.5)
-        self.allow_multiple_publishers = get("allow_multiple_cmd_vel_publishers", True, bool)
         self.base_frame_id = get("base_frame_id", "base_link", str)
-        self.odom_frame_id = get("odom_frame_id", "odom", str)
         self.enable_odom_tf = get("enable_odom_tf", True, bool)
         self.limiter_linear = SpeedLimiter.from_params(params, "linear/x", name)
         self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
         self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
         self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
-        # linear, angular, stamp (sim s): one tuple, replaced whole by the ROS thread, read whole by the loop
-        self._command = (0.0, 0.0, -math.inf)
-        self.last0 = self.last1 = (0.0, 0.0)
+        self.last0 = self.last1 = (0.0, 0.0)  # (linear, angular) after the limiters, the last two cycles
         self.last_publish = 0.0
 
-    def set_command(self, linear: float, angular: float, stamp: float, publishers: int = 1) -> Optional[str]:
-        """cmdVelCallback: None when taken, else upstream's complaint (the ROS layer logs it, throttled)."""
-        if self.state != "running":
-            return "Can't accept new commands. Controller is not running."
-        if not self.allow_multiple_publishers and publishers > 1:
-            self.brake()
-            return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            return "Received NaN in velocity command. Ignoring."
-        self._command = (linear, angular, stamp)
-        return None
-
     def brake(self):
+        raise NotImplementedError
+
+    def forget_commands(self):
+        """Sim time was reset: the commands' stamps mean nothing any more."""
         raise NotImplementedError
 
     def starting(self, now):
@@ -229,12 +215,50 @@ class TwistController(Controller):
     def restart_clock(self, now):
         self.last_publish = now
         self.odometry.timestamp = now
+        self.forget_commands()
+
+    def odometry_due(self, now) -> bool:
+        """Whether the odometry's publish period has passed (then the next period starts)."""
+        if self.last_publish + 1.0 / self.publish_rate < now:
+            self.last_publish += 1.0 / self.publish_rate
+            return True
+        return False
+
+
+class TwistController(OdometryController):
+    """The cmd_vel bases (diff drive, Ackermann steering): ``open_loop``, the odom frame, the publishers' check
+    and one (linear.x, angular.z) command."""
+    publish_cmd = False  # cmd_vel_out, the diff drive's option
+
+    def __init__(self, name, hw, params, context, odometry: "DiffDriveOdometry"):
+        super().__init__(name, hw, params, context, odometry)
+
+        def get(key, default, kind=float):
+            return param(params, key, default, kind, name)
+        self.open_loop = get("open_loop", False, bool)
+        self.allow_multiple_publishers = get("allow_multiple_cmd_vel_publishers", True, bool)
+        self.odom_frame_id = get("odom_frame_id", "odom", str)
+        # linear, angular, stamp (sim s): one tuple, replaced whole by the ROS thread, read whole by the loop
+        self._command = (0.0, 0.0, -math.inf)
+
+    def set_command(self, linear: float, angular: float, stamp: float, publishers: int = 1) -> Optional[str]:
+        """cmdVelCallback: None when taken, else upstream's complaint (the ROS layer logs it, throttled)."""
+        if self.state != "running":
+            return "Can't accept new commands. Controller is not running."
+        if not self.allow_multiple_publishers and publishers > 1:
+            self.brake()
+            return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return "Received NaN in velocity command. Ignoring."
+        self._command = (linear, angular, stamp)
+        return None
+
+    def forget_commands(self):
         self._command = (0.0, 0.0, -math.inf)
 
     def sample_odometry(self, now):
         """The odometry into the outbox when its publish period has passed."""
-        if self.last_publish + 1.0 / self.publish_rate < now:
-            self.last_publish += 1.0 / self.publish_rate
+        if self.odometry_due(now):
             odometry = self.odometry
             self.outbox.append((now, OdometrySample(odometry.x, odometry.y, odometry.heading, odometry.linear,
                                                     odometry.angular)))

@@ -12,10 +12,10 @@ from typing import List, NamedTuple, Optional, Tuple
 
 from ..description.robot_model import RobotModel
 from ..log import get_logger, warn_once
-from .controller_interface import Controller, param
+from .controller_interface import param
 from .controller_manager import ControllerInitError
-from .diff_drive_controller import SpeedLimiter, _covariance_diagonal, _wheel_names
-from .hardware_interface import POSITION, VELOCITY
+from .diff_drive_controller import OdometryController, _wheel_names
+from .hardware_interface import POSITION
 
 _logger = get_logger(__name__)
 
@@ -210,11 +210,9 @@ def _joint_radius(urdf: RobotModel, joint_name: str) -> float:
     return link.collision_radii[0]
 
 
-class FourWheelSteeringController(Controller):
-    INTERFACE = VELOCITY
-
+class FourWheelSteeringController(OdometryController):
     def __init__(self, name, hw, params, context):
-        super().__init__(name, hw, params, context)
+        super().__init__(name, hw, params, context, FourWheelSteeringOdometry())
         front_wheels, rear_wheels = _wheel_names(params, "front_wheel"), _wheel_names(params, "rear_wheel")
         if len(front_wheels) != len(rear_wheels):
             raise ControllerInitError(f"#front wheels ({len(front_wheels)}) != #rear wheels ({len(rear_wheels)}).")
@@ -231,20 +229,10 @@ class FourWheelSteeringController(Controller):
 
         def get(key, default, kind=float):
             return param(params, key, default, kind, name)
-        self.publish_rate = get("publish_rate", 50.0)
-        if math.isnan(self.publish_rate) or self.publish_rate == 0:  # upstream's Duration(1 / rate) throws
-            raise ControllerInitError(f"publish_rate {self.publish_rate} gives no publish period; it must be a "
-                                      "number other than 0")
         if get("open_loop", False, bool):
             warn_once(_logger, f"{name}: open_loop is read but not used by four_wheel_steering_controller; the "
                                "odometry comes from the joints")
-        self.odometry = FourWheelSteeringOdometry(get("velocity_rolling_window_size", 10, int))
-        self.cmd_vel_timeout = get("cmd_vel_timeout", 0.5)
-        self.base_frame_id = get("base_frame_id", "base_link", str)
         self.odom_frame_id = "odom"  # fixed in upstream
-        self.enable_odom_tf = get("enable_odom_tf", True, bool)
-        self.limiter_linear = SpeedLimiter.from_params(params, "linear/x", name)
-        self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
         self.limiter_linear.has_jerk_limits = self.limiter_angular.has_jerk_limits = False  # upstream reads none
         self.track, self.wheel_radius, self.wheel_base = get("track", None), get("wheel_radius", None), \
             get("wheel_base", None)
@@ -253,8 +241,6 @@ class FourWheelSteeringController(Controller):
                                        self.wheel_radius, self.wheel_base)
         _logger.info(f"{name}: Odometry params : track {self.track}, wheel radius {self.wheel_radius}, wheel base "
                      f"{self.wheel_base}, wheel steering offset {self.wheel_steering_y_offset}")
-        self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
-        self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
         # front left, front right, rear left, rear right
         self.wheels = [self.handle(joint) for joint in front_wheels + rear_wheels]
         self.steerings = [self.handle(joint, POSITION) for joint in front_steering + rear_steering]
@@ -262,8 +248,6 @@ class FourWheelSteeringController(Controller):
         # replaced whole by the ROS thread; the later stamp wins, as upstream.
         self._twist = (0.0, 0.0, 0.0, 0.0)
         self._steering = (0.0, 0.0, 0.0, 0.0)
-        self.last0 = self.last1 = (0.0, 0.0)  # (linear, angular) after the limiters
-        self.last_publish = 0.0
 
     def _geometry_from_urdf(self, urdf: Optional[RobotModel], front_wheels, rear_wheels, front_steering):
         if urdf is None:
@@ -308,17 +292,7 @@ class FourWheelSteeringController(Controller):
         for joint in self.wheels + self.steerings:
             joint.command = 0.0
 
-    def starting(self, now):
-        self.brake()
-        self.last_publish = now
-        self.odometry.init(now)
-
-    def stopping(self, now):
-        self.brake()
-
-    def restart_clock(self, now):
-        self.last_publish = now
-        self.odometry.timestamp = now
+    def forget_commands(self):
         self._twist = self._steering = (0.0, 0.0, 0.0, -math.inf)
 
     @staticmethod
@@ -341,8 +315,7 @@ class FourWheelSteeringController(Controller):
         rear = self._axle_steering(angles[2], angles[3])
         odometry = self.odometry
         odometry.update(*speeds, front, rear, now)
-        if self.last_publish + 1.0 / self.publish_rate < now:
-            self.last_publish += 1.0 / self.publish_rate
+        if self.odometry_due(now):
             self.outbox.append((now, FourWheelOdometrySample(
                 odometry.x, odometry.y, odometry.heading, odometry.linear_x, odometry.linear_y, odometry.angular,
                 odometry.linear, odometry.acceleration.mean, odometry.jerk.mean, front,
