@@ -1,4 +1,4 @@
-"""The ROS side of the ros_controllers (``core/controllers.py``): their topics, under the controller's namespace
+"""The ROS side of the ros_controllers (``core/ros_control/``): their topics, under the controller's namespace
 (``<robot namespace>/<controller name>``) as upstream's controller NodeHandle puts them.
 
 Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock, at the stop of the loop
@@ -17,10 +17,10 @@ from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectory
                               GripperCommandAction, GripperCommandResult, JointControllerState,
                               JointTrajectoryControllerState)
 from control_msgs.srv import QueryTrajectoryState, QueryTrajectoryStateResponse
+from four_wheel_steering_msgs.msg import FourWheelSteering, FourWheelSteeringStamped
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
-from four_wheel_steering_msgs.msg import FourWheelSteering, FourWheelSteeringStamped
 from std_msgs.msg import Float64, Float64MultiArray
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage

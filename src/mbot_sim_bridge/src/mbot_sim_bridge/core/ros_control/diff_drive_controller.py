@@ -1,8 +1,9 @@
-"""diff_drive_controller/DiffDriveController (its base ``TwistController`` and its odometry serve the Ackermann
-steering controller too): wheels as names or lists, geometry from the parameters or the URDF, multipliers,
-``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact arc / Runge-Kutta 2
-with a rolling mean of the speeds), ``open_loop``; the odometry (at ``publish_rate``) and ``cmd_vel_out`` (with
-``publish_cmd``, every cycle) filled into the ``outbox``."""
+"""diff_drive_controller/DiffDriveController, and the bases it shares with the steering controllers
+(``OdometryController``: what every wheeled base reads; ``TwistController``: the cmd_vel ones, also the Ackermann
+steering controller's, which extends this odometry): wheels as names or lists, geometry from the parameters or
+the URDF, multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact
+arc / Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``; the odometry (at ``publish_rate``) and
+``cmd_vel_out`` (with ``publish_cmd``, every cycle) filled into the ``outbox``."""
 import collections
 import math
 import operator
