@@ -17,6 +17,8 @@ from mbot_sim_bridge.robot_description import expand_xacro
 WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
 MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
 ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
+CAR = os.path.join(WORKSPACE_SRC, "car_description", "urdf", "car.urdf.xacro")
+CAR_CONFIG = os.path.join(WORKSPACE_SRC, "car_gazebo", "config", "car_{}_controllers.yaml")
 
 
 def load_yaml(path):
@@ -75,6 +77,17 @@ def recording_batches(sim):
 
 def expand_xacro_arm(interface):
     return expand_xacro(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"), interface=interface)
+
+
+def expand_xacro_car(steering):
+    return expand_xacro(CAR, steering=steering)
+
+
+def car(steering):
+    """car_gazebo's car with ``steering`` (ackermann or four_wheel), its car_controller started."""
+    sim, spawned, plugin = simulate(expand_xacro_car(steering), load_yaml(CAR_CONFIG.format(steering)), "car",
+                                    namespace="/")
+    return sim, spawned, plugin, start_controllers(sim, plugin, "car_controller", "joint_state_controller")
 
 
 def arm(interface):

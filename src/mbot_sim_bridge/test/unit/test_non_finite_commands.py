@@ -9,12 +9,14 @@ import pytest
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.ros_control.controller_table import CORE_CONTROLLERS
-from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
+from mbot_sim_bridge.core.ros_control.diff_drive_controller import TwistController
+from mbot_sim_bridge.core.ros_control.four_wheel_steering_controller import FourWheelSteeringController
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (JointTrajectory, JointTrajectoryController,
                                                                           TrajectoryPoint)
 
-from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, start_controllers
+from ros_control_fixtures import (CAR_CONFIG, MBOT_YAML, ROBOTS, expand_xacro_arm, expand_xacro_car, load_yaml,
+                                  simulate, start_controllers)
 from sensor_fixtures import course_urdf
 
 BYSTANDER_TOLERANCE = 1e-3  # m
@@ -55,6 +57,10 @@ COMMANDED = {
                                                                    "shoulder": {"pid": ARM_PID},
                                                                    "elbow": {"pid": ARM_PID}}),
     "diff_drive_controller/DiffDriveController": ("mbot", load_yaml(MBOT_YAML)["mobile_base_controller"]),
+    "ackermann_steering_controller/AckermannSteeringController":
+        ("ackermann", load_yaml(CAR_CONFIG.format("ackermann"))["car_controller"]),
+    "four_wheel_steering_controller/FourWheelSteeringController":
+        ("four_wheel", load_yaml(CAR_CONFIG.format("four_wheel"))["car_controller"]),
     "position_controllers/JointTrajectoryController": ("Position", {"joints": ["shoulder", "elbow"]}),
     "velocity_controllers/JointTrajectoryController": ("Velocity", {"joints": ["shoulder", "elbow"],
                                                                     "gains": {"shoulder": {"p": 20.0},
@@ -72,8 +78,12 @@ def test_every_commanded_controller_type_is_fuzzed():
 
 def command(sim, controller, value):
     """``value`` for every joint, as the controller's command topic would carry it; the refusal, if any."""
-    if isinstance(controller, DiffDriveController):
+    if isinstance(controller, TwistController):
         return controller.set_command(value, value, sim.sim_time)
+    if isinstance(controller, FourWheelSteeringController):  # both its topics
+        complaints = [controller.set_twist(value, value, value, sim.sim_time),
+                      controller.set_steering(value, value, value, sim.sim_time)]
+        return complaints[0] or complaints[1]
     if isinstance(controller, JointTrajectoryController):
         controller.command(JointTrajectory(controller.joint_names,
                                            [TrajectoryPoint([value] * len(controller.joints), time_from_start=0.5)]))
@@ -89,10 +99,14 @@ def command(sim, controller, value):
 @pytest.mark.parametrize("controller_type", sorted(COMMANDED))
 def test_non_finite_and_huge_commands_disturb_no_other_model(mbot_ros_control_urdf, controller_type, caplog):
     robot, config = COMMANDED[controller_type]
-    urdf = mbot_ros_control_urdf if robot == "mbot" else expand_xacro_arm(robot)
-    name = "mbot" if robot == "mbot" else "arm"
+    if robot == "mbot":
+        urdf, name = mbot_ros_control_urdf, "mbot"
+    elif robot in ("ackermann", "four_wheel"):
+        urdf, name = expand_xacro_car(robot), "car"
+    else:
+        urdf, name = expand_xacro_arm(robot), "arm"
     sim, spawned, plugin = simulate(urdf, {"fuzzed": dict(config, type=controller_type)}, name,
-                                    namespace="/" if robot == "mbot" else None)  # the mbot's robotNamespace
+                                    namespace=None if name == "arm" else "/")  # the others' robotNamespace
     try:
         resting = with_bystander(sim, mbot_ros_control_urdf)
         controller = start_controllers(sim, plugin, "fuzzed")
@@ -100,7 +114,7 @@ def test_non_finite_and_huge_commands_disturb_no_other_model(mbot_ros_control_ur
             complaint = command(sim, controller, value)
             if not math.isfinite(value):  # refused: said once by the controller, or answered as upstream does
                 said = messages(caplog, "controller 'fuzzed'", f"command {value}", "not a finite number")
-                assert len(said) == 1 or complaint == "Received NaN in velocity command. Ignoring.", value
+                assert len(said) == 1 or complaint.startswith("Received NaN in "), value
             sim.step(300)
             position = sim.engine.model_pose(name).position
             assert all(math.isfinite(v) for v in position), (value, position)

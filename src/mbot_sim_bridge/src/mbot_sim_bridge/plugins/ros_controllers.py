@@ -1,4 +1,4 @@
-"""The ROS side of the ros_controllers (``core/controllers.py``): their topics, under the controller's namespace
+"""The ROS side of the ros_controllers (``core/ros_control/``): their topics, under the controller's namespace
 (``<robot namespace>/<controller name>``) as upstream's controller NodeHandle puts them.
 
 Subscribers only store values; ``publish(stamp)`` runs in the loop thread after /clock, at the stop of the loop
@@ -17,6 +17,7 @@ from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectory
                               GripperCommandAction, GripperCommandResult, JointControllerState,
                               JointTrajectoryControllerState)
 from control_msgs.srv import QueryTrajectoryState, QueryTrajectoryStateResponse
+from four_wheel_steering_msgs.msg import FourWheelSteering, FourWheelSteeringStamped
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
@@ -25,7 +26,8 @@ from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMessage
 
 from ..core.ros_control.controller_table import CORE_CONTROLLERS
-from ..core.ros_control.diff_drive_controller import CommandSample, DiffDriveController, OdometrySample
+from ..core.ros_control.diff_drive_controller import CommandSample, TwistController
+from ..core.ros_control.four_wheel_steering_controller import FourWheelSteeringController
 from ..core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from ..core.ros_control.joint_state_controller import JointStateController
 from ..core.ros_control.joint_trajectory_controller import (ABORTED, SUCCEEDED, JointTolerance, JointTrajectory,
@@ -58,14 +60,45 @@ class RosJointStateController(JointStateController):
         self.publisher.unregister()
 
 
-class RosDiffDriveController(DiffDriveController):
+def advertise_odometry(controller, context) -> str:
+    """A base controller's clock, frames, ``odom`` and /tf publishers; its namespace."""
+    controller.clock = context.clock
+    controller.odom_frame = resolve_frame(controller.odom_frame_id)
+    controller.base_frame = resolve_frame(controller.base_frame_id)
+    controller.odom_publisher = loop_publisher(context.namespace + "/odom", Odometry)
+    controller.tf_publisher = loop_publisher("/tf", TFMessage)
+    return context.namespace
+
+
+def publish_odometry(controller, stamp, odometry, linear_x: float, linear_y: float):
+    """A base controller's nav_msgs/Odometry on ``odom`` and, with ``enable_odom_tf``, the odom TF."""
+    message = Odometry()
+    message.header.stamp = stamp
+    message.header.frame_id = controller.odom_frame
+    message.child_frame_id = controller.base_frame
+    pose = message.pose.pose
+    pose.position.x, pose.position.y = odometry.x, odometry.y
+    pose.orientation.z, pose.orientation.w = math.sin(odometry.heading / 2), math.cos(odometry.heading / 2)
+    message.pose.covariance = diagonal_covariance(controller.pose_covariance, 6)
+    twist = message.twist.twist
+    twist.linear.x, twist.linear.y, twist.angular.z = linear_x, linear_y, odometry.angular
+    message.twist.covariance = diagonal_covariance(controller.twist_covariance, 6)
+    controller.odom_publisher.publish(message)
+    if controller.enable_odom_tf:
+        transform = TransformStamped()
+        transform.header = message.header
+        transform.child_frame_id = controller.base_frame
+        transform.transform.translation.x, transform.transform.translation.y = odometry.x, odometry.y
+        transform.transform.rotation = pose.orientation
+        controller.tf_publisher.publish(TFMessage([transform]))
+
+
+class RosTwistController(TwistController):
+    """cmd_vel in, odom and the odom TF out (and cmd_vel_out for the diff drive's ``publish_cmd``)."""
+
     def __init__(self, name, hw, params, context):
         super().__init__(name, hw, params, context)
-        self.clock = context.clock
-        namespace = context.namespace
-        self.odom_frame, self.base_frame = resolve_frame(self.odom_frame_id), resolve_frame(self.base_frame_id)
-        self.odom_publisher = loop_publisher(namespace + "/odom", Odometry)
-        self.tf_publisher = loop_publisher("/tf", TFMessage)
+        namespace = advertise_odometry(self, context)
         self.cmd_publisher = loop_publisher(namespace + "/cmd_vel_out", TwistStamped) if self.publish_cmd else None
         self.subscriber = TrackedSubscriber(namespace + "/cmd_vel", Twist, self._on_command)
 
@@ -83,33 +116,56 @@ class RosDiffDriveController(DiffDriveController):
                 message.twist.linear.x, message.twist.angular.z = sample.linear, sample.angular
                 self.cmd_publisher.publish(message)
             else:
-                self._publish_odometry(ros_time(time), sample)
-
-    def _publish_odometry(self, stamp, odometry: OdometrySample):
-        message = Odometry()
-        message.header.stamp = stamp
-        message.header.frame_id = self.odom_frame
-        message.child_frame_id = self.base_frame
-        pose = message.pose.pose
-        pose.position.x, pose.position.y = odometry.x, odometry.y
-        pose.orientation.z, pose.orientation.w = math.sin(odometry.heading / 2), math.cos(odometry.heading / 2)
-        message.pose.covariance = diagonal_covariance(self.pose_covariance, 6)
-        message.twist.twist.linear.x, message.twist.twist.angular.z = odometry.linear, odometry.angular
-        message.twist.covariance = diagonal_covariance(self.twist_covariance, 6)
-        self.odom_publisher.publish(message)
-        if self.enable_odom_tf:
-            transform = TransformStamped()
-            transform.header = message.header
-            transform.child_frame_id = self.base_frame
-            transform.transform.translation.x, transform.transform.translation.y = odometry.x, odometry.y
-            transform.transform.rotation = pose.orientation
-            self.tf_publisher.publish(TFMessage([transform]))
+                publish_odometry(self, ros_time(time), sample, sample.linear, 0.0)
 
     def close(self):
         self.subscriber.unregister()
         for publisher in (self.odom_publisher, self.tf_publisher, self.cmd_publisher):
             if publisher is not None:
                 publisher.unregister()
+
+
+class RosFourWheelSteeringController(FourWheelSteeringController):
+    """cmd_vel and cmd_four_wheel_steering in; odom, odom_steer and the odom TF out."""
+
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context)
+        namespace = advertise_odometry(self, context)
+        self.steering_publisher = loop_publisher(namespace + "/odom_steer", FourWheelSteeringStamped)
+        self.subscribers = [TrackedSubscriber(namespace + "/cmd_vel", Twist, self._on_twist),
+                            TrackedSubscriber(namespace + "/cmd_four_wheel_steering", FourWheelSteering,
+                                              self._on_steering)]
+
+    def _on_twist(self, message: Twist):
+        self._complain(self.set_twist(message.linear.x, message.linear.y, message.angular.z, self.clock()))
+
+    def _on_steering(self, message: FourWheelSteering):
+        self._complain(self.set_steering(message.speed, message.front_steering_angle, message.rear_steering_angle,
+                                         self.clock()))
+
+    def _complain(self, complaint):
+        if complaint:
+            rospy.logwarn_throttle(1.0, f"{self.name}: {complaint}")
+
+    def publish(self, stamp):
+        for time, sample in self.outbox:
+            publish_odometry(self, ros_time(time), sample, sample.linear_x, sample.linear_y)
+            message = FourWheelSteeringStamped()
+            message.header.stamp = ros_time(time)
+            message.header.frame_id = self.odom_frame
+            data = message.data
+            data.speed, data.acceleration, data.jerk = sample.speed, sample.acceleration, sample.jerk
+            data.front_steering_angle = sample.front_steering
+            data.front_steering_angle_velocity = sample.front_steering_velocity
+            data.rear_steering_angle = sample.rear_steering
+            data.rear_steering_angle_velocity = sample.rear_steering_velocity
+            self.steering_publisher.publish(message)
+
+    def close(self):
+        for subscriber in self.subscribers:
+            subscriber.unregister()
+        for publisher in (self.odom_publisher, self.steering_publisher, self.tf_publisher):
+            publisher.unregister()
 
 
 class _CommandTopic:
@@ -289,7 +345,8 @@ def _ros_class(core_class: type) -> type:
 
 def _ros_controller(core_class: type) -> type:
     for core_base, ros_class in ((JointStateController, RosJointStateController),
-                                 (DiffDriveController, RosDiffDriveController),
+                                 (TwistController, RosTwistController),
+                                 (FourWheelSteeringController, RosFourWheelSteeringController),
                                  (JointTrajectoryController, RosJointTrajectoryController),
                                  (GripperActionController, RosGripperActionController)):
         if core_class is core_base:

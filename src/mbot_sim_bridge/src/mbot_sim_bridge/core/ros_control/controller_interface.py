@@ -2,7 +2,7 @@
 import math
 import sys
 from dataclasses import dataclass
-from typing import Any, Callable, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..log import get_logger, warn_once
 from ..description.robot_model import RobotModel
@@ -52,17 +52,19 @@ class Controller:
         self.hw = hw
         self.params = params
         self.state = "initialized"
-        self.claimed: List[str] = []
+        self.claimed: Dict[str, List[str]] = {}  # joints by hardware interface, in claiming order
         # What update() filled for the ROS layer at the step it was due, as (sim time, sample): upstream's
         # controllers fill their realtime publishers' messages in update, and another thread sends them. The
         # loop sends these at its next stop (at most MAX_BATCH_SIM_SECONDS later), so they need no stop of their
         # own; the plugin then empties the list.
         self.outbox: List[Tuple[float, Any]] = []
 
-    def handle(self, joint: str):
-        handle = self.hw.handle(joint, self.INTERFACE)
-        if self.INTERFACE != JOINT_STATE and joint not in self.claimed:
-            self.claimed.append(joint)
+    def handle(self, joint: str, interface: Optional[str] = None):
+        """The joint's handle on ``interface`` (default: the controller's), claimed unless a state handle."""
+        interface = interface or self.INTERFACE
+        handle = self.hw.handle(joint, interface)
+        if interface != JOINT_STATE and joint not in self.claimed.setdefault(interface, []):
+            self.claimed[interface].append(joint)
         return handle
 
     def finite_command(self, joints: Sequence[str], values: Sequence[float]) -> bool:

@@ -88,7 +88,8 @@ class ControllerManager:
                 _logger.error(f"Exception thrown while initializing controller '{name}'.\n{error}")
                 _logger.error(f"Initializing controller '{name}' failed")
                 return False
-            claimed = [(INTERFACE_TYPES[controller.INTERFACE], list(controller.claimed))]
+            claimed = ([(INTERFACE_TYPES[interface], list(joints)) for interface, joints in controller.claimed.items()]
+                       or [(INTERFACE_TYPES[controller.INTERFACE], [])])
             self.controllers = self.controllers + [LoadedController(name, controller_type, controller, claimed)]
             _logger.debug(f"Successfully load controller '{name}'")
             return True

@@ -5,8 +5,10 @@ Its own module, not the package's ``__init__``: a robot without ros_control (who
 """
 from typing import Dict
 
+from .ackermann_steering_controller import AckermannSteeringController
 from .diff_drive_controller import DiffDriveController
 from .gripper_action_controller import GripperActionController
+from .four_wheel_steering_controller import FourWheelSteeringController
 from .forward_command_controller import ForwardCommandController, ForwardJointGroupCommandController, forward_type
 from .hardware_interface import EFFORT, POSITION, VELOCITY
 from .joint_state_controller import JointStateController
@@ -17,6 +19,8 @@ from .pid_controllers import EffortGroupPositionController, EffortVelocityContro
 CORE_CONTROLLERS: Dict[str, type] = {
     "joint_state_controller/JointStateController": JointStateController,
     "diff_drive_controller/DiffDriveController": DiffDriveController,
+    "ackermann_steering_controller/AckermannSteeringController": AckermannSteeringController,
+    "four_wheel_steering_controller/FourWheelSteeringController": FourWheelSteeringController,
     "velocity_controllers/JointPositionController":
         type("VelocityJointPositionController", (PidPositionController,), {"INTERFACE": VELOCITY}),
     "effort_controllers/JointPositionController":

@@ -1,6 +1,8 @@
-"""diff_drive_controller/DiffDriveController: wheels as names or lists, geometry from the parameters or the
-URDF, multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact arc /
-Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``; the odometry (at ``publish_rate``) and
+"""diff_drive_controller/DiffDriveController, and the bases it shares with the steering controllers
+(``OdometryController``: what every wheeled base reads; ``TwistController``: the cmd_vel ones, also the Ackermann
+steering controller's, which extends this odometry): wheels as names or lists, geometry from the parameters or
+the URDF, multipliers, ``cmd_vel_timeout``, the speed limiter, odometry integrated from the wheel positions (exact
+arc / Runge-Kutta 2 with a rolling mean of the speeds), ``open_loop``; the odometry (at ``publish_rate``) and
 ``cmd_vel_out`` (with ``publish_cmd``, every cycle) filled into the ``outbox``."""
 import collections
 import math
@@ -97,8 +99,12 @@ class DiffDriveOdometry:
         left, right = left_position * self.left_radius, right_position * self.right_radius
         left_delta, right_delta = left - self.left_old, right - self.right_old
         self.left_old, self.right_old = left, right
-        linear = (right_delta + left_delta) * 0.5
-        angular = (right_delta - left_delta) / self.wheel_separation
+        return self.integrate_speeds((right_delta + left_delta) * 0.5,
+                                     (right_delta - left_delta) / self.wheel_separation, now)
+
+    def integrate_speeds(self, linear: float, angular: float, now: float) -> bool:
+        """The pose moved by this update's travel and turn; the speeds' rolling means unless too little time
+        has passed."""
         self.integrate(linear, angular)
         dt = now - self.timestamp
         if dt < 0.0001:
@@ -165,15 +171,14 @@ def _covariance_diagonal(params: dict, key: str, name: str) -> List[float]:
     return [float(v) for v in value]
 
 
-class DiffDriveController(Controller):
+class OdometryController(Controller):
+    """What ros_controllers' wheeled bases share (diff drive, Ackermann and four-wheel steering): the odometry's
+    publish rate and rolling window, ``cmd_vel_timeout``, the base frame, ``enable_odom_tf``, the covariances and
+    the linear/angular speed limiters, as each reads them; braking on start and stop."""
     INTERFACE = VELOCITY
 
-    def __init__(self, name, hw, params, context):
+    def __init__(self, name, hw, params, context, odometry):
         super().__init__(name, hw, params, context)
-        left, right = _wheel_names(params, "left_wheel"), _wheel_names(params, "right_wheel")
-        if len(left) != len(right):
-            raise ControllerInitError(f"#left wheels ({len(left)}) != #right wheels ({len(right)}).")
-        self.left_names, self.right_names = left, right
 
         def get(key, default, kind=float):
             return param(params, key, default, kind, name)
@@ -181,21 +186,112 @@ class DiffDriveController(Controller):
         if math.isnan(self.publish_rate) or self.publish_rate == 0:  # upstream's Duration(1 / rate) throws
             raise ControllerInitError(f"publish_rate {self.publish_rate} gives no publish period; it must be a "
                                       "number other than 0")
+        odometry.window = get("velocity_rolling_window_size", 10, int)
+        self.odometry = odometry
+        self.cmd_vel_timeout = get("cmd_vel_timeout", 0.5)
+        self.base_frame_id = get("base_frame_id", "base_link", str)
+        self.enable_odom_tf = get("enable_odom_tf", True, bool)
+        self.limiter_linear = SpeedLimiter.from_params(params, "linear/x", name)
+        self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
+        self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
+        self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
+        self.last0 = self.last1 = (0.0, 0.0)  # (linear, angular) after the limiters, the last two cycles
+        self.last_publish = 0.0
+
+    def brake(self):
+        raise NotImplementedError
+
+    def forget_commands(self):
+        """Sim time was reset: the commands' stamps mean nothing any more."""
+        raise NotImplementedError
+
+    def starting(self, now):
+        self.brake()
+        self.last_publish = now
+        self.odometry.init(now)
+
+    def stopping(self, now):
+        self.brake()
+
+    def restart_clock(self, now):
+        self.last_publish = now
+        self.odometry.timestamp = now
+        self.forget_commands()
+
+    def odometry_due(self, now) -> bool:
+        """Whether the odometry's publish period has passed (then the next period starts)."""
+        if self.last_publish + 1.0 / self.publish_rate < now:
+            self.last_publish += 1.0 / self.publish_rate
+            return True
+        return False
+
+
+class TwistController(OdometryController):
+    """The cmd_vel bases (diff drive, Ackermann steering): ``open_loop``, the odom frame, the publishers' check
+    and one (linear.x, angular.z) command."""
+    publish_cmd = False  # cmd_vel_out, the diff drive's option
+
+    def __init__(self, name, hw, params, context, odometry: "DiffDriveOdometry"):
+        super().__init__(name, hw, params, context, odometry)
+
+        def get(key, default, kind=float):
+            return param(params, key, default, kind, name)
         self.open_loop = get("open_loop", False, bool)
+        self.allow_multiple_publishers = get("allow_multiple_cmd_vel_publishers", True, bool)
+        self.odom_frame_id = get("odom_frame_id", "odom", str)
+        # linear, angular, stamp (sim s): one tuple, replaced whole by the ROS thread, read whole by the loop
+        self._command = (0.0, 0.0, -math.inf)
+
+    def set_command(self, linear: float, angular: float, stamp: float, publishers: int = 1) -> Optional[str]:
+        """cmdVelCallback: None when taken, else upstream's complaint (the ROS layer logs it, throttled)."""
+        if self.state != "running":
+            return "Can't accept new commands. Controller is not running."
+        if not self.allow_multiple_publishers and publishers > 1:
+            self.brake()
+            return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return "Received NaN in velocity command. Ignoring."
+        self._command = (linear, angular, stamp)
+        return None
+
+    def forget_commands(self):
+        self._command = (0.0, 0.0, -math.inf)
+
+    def sample_odometry(self, now):
+        """The odometry into the outbox when its publish period has passed."""
+        if self.odometry_due(now):
+            odometry = self.odometry
+            self.outbox.append((now, OdometrySample(odometry.x, odometry.y, odometry.heading, odometry.linear,
+                                                    odometry.angular)))
+
+    def limited_command(self, now, period):
+        """The command (zero after ``cmd_vel_timeout``) through the speed limiters, remembered for the next."""
+        linear, angular, stamp = self._command
+        if now - stamp > self.cmd_vel_timeout:
+            linear = angular = 0.0
+        linear = self.limiter_linear.limit(linear, self.last0[0], self.last1[0], period)
+        angular = self.limiter_angular.limit(angular, self.last0[1], self.last1[1], period)
+        self.last1 = self.last0
+        self.last0 = (linear, angular)
+        return linear, angular
+
+
+class DiffDriveController(TwistController):
+    def __init__(self, name, hw, params, context):
+        super().__init__(name, hw, params, context, DiffDriveOdometry())
+        left, right = _wheel_names(params, "left_wheel"), _wheel_names(params, "right_wheel")
+        if len(left) != len(right):
+            raise ControllerInitError(f"#left wheels ({len(left)}) != #right wheels ({len(right)}).")
+        self.left_names, self.right_names = left, right
+
+        def get(key, default, kind=float):
+            return param(params, key, default, kind, name)
         self.wheel_separation_multiplier = get("wheel_separation_multiplier", 1.0)
         if "wheel_radius_multiplier" in params:
             self.left_radius_multiplier = self.right_radius_multiplier = get("wheel_radius_multiplier", 1.0)
         else:
             self.left_radius_multiplier = get("left_wheel_radius_multiplier", 1.0)
             self.right_radius_multiplier = get("right_wheel_radius_multiplier", 1.0)
-        self.odometry = DiffDriveOdometry(get("velocity_rolling_window_size", 10, int))
-        self.cmd_vel_timeout = get("cmd_vel_timeout", 0.5)
-        self.allow_multiple_publishers = get("allow_multiple_cmd_vel_publishers", True, bool)
-        self.base_frame_id = get("base_frame_id", "base_link", str)
-        self.odom_frame_id = get("odom_frame_id", "odom", str)
-        self.enable_odom_tf = get("enable_odom_tf", True, bool)
-        self.limiter_linear = SpeedLimiter.from_params(params, "linear/x", name)
-        self.limiter_angular = SpeedLimiter.from_params(params, "angular/z", name)
         self.publish_cmd = get("publish_cmd", False, bool)
         if get("publish_wheel_joint_controller_state", False, bool):
             warn_once(_logger, f"{name}: publish_wheel_joint_controller_state is not supported; the wheels' "
@@ -203,18 +299,12 @@ class DiffDriveController(Controller):
         self.wheel_separation = get("wheel_separation", None)
         self.wheel_radius = get("wheel_radius", None)
         self._geometry_from_urdf(context.urdf, left[0], right[0])
-        self.pose_covariance = _covariance_diagonal(params, "pose_covariance_diagonal", name)
-        self.twist_covariance = _covariance_diagonal(params, "twist_covariance_diagonal", name)
         self._apply_wheel_params()
         separation, left_radius, right_radius = self.wheel_params()
         _logger.info(f"{name}: Odometry params : wheel separation {separation}, left wheel radius {left_radius}, "
                      f"right wheel radius {right_radius}")
         self.left = [self.handle(joint) for joint in left]
         self.right = [self.handle(joint) for joint in right]
-        # linear, angular, stamp (sim s): one tuple, replaced whole by the ROS thread, read whole by the loop
-        self._command = (0.0, 0.0, -math.inf)
-        self.last0 = self.last1 = (0.0, 0.0)
-        self.last_publish = 0.0
 
     def _geometry_from_urdf(self, urdf: Optional[RobotModel], left: str, right: str):
         if self.wheel_separation is not None and self.wheel_radius is not None:
@@ -245,34 +335,9 @@ class DiffDriveController(Controller):
         self.wheel_params_applied = self.wheel_params()
         self.odometry.set_wheel_params(*self.wheel_params_applied)
 
-    def set_command(self, linear: float, angular: float, stamp: float, publishers: int = 1) -> Optional[str]:
-        """cmdVelCallback: None when taken, else upstream's complaint (the ROS layer logs it, throttled)."""
-        if self.state != "running":
-            return "Can't accept new commands. Controller is not running."
-        if not self.allow_multiple_publishers and publishers > 1:
-            self.brake()
-            return f"Detected {publishers} publishers. Only 1 publisher is allowed. Going to brake."
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            return "Received NaN in velocity command. Ignoring."
-        self._command = (linear, angular, stamp)
-        return None
-
     def brake(self):
         for joint in self.left + self.right:
             joint.command = 0.0
-
-    def starting(self, now):
-        self.brake()
-        self.last_publish = now
-        self.odometry.init(now)
-
-    def stopping(self, now):
-        self.brake()
-
-    def restart_clock(self, now):
-        self.last_publish = now
-        self.odometry.timestamp = now
-        self._command = (0.0, 0.0, -math.inf)
 
     def update(self, now, period):
         # Upstream re-applies the multipliers every cycle for dynamic_reconfigure, which is not served here:
@@ -287,17 +352,8 @@ class DiffDriveController(Controller):
             if math.isnan(left) or math.isnan(right):
                 return
             odometry.update(left, right, now)
-        if self.last_publish + 1.0 / self.publish_rate < now:
-            self.last_publish += 1.0 / self.publish_rate
-            self.outbox.append((now, OdometrySample(odometry.x, odometry.y, odometry.heading, odometry.linear,
-                                                    odometry.angular)))
-        linear, angular, stamp = self._command
-        if now - stamp > self.cmd_vel_timeout:
-            linear = angular = 0.0
-        linear = self.limiter_linear.limit(linear, self.last0[0], self.last1[0], period)
-        angular = self.limiter_angular.limit(angular, self.last0[1], self.last1[1], period)
-        self.last1 = self.last0
-        self.last0 = (linear, angular)
+        self.sample_odometry(now)
+        linear, angular = self.limited_command(now, period)
         if self.publish_cmd:  # cmd_vel_out: every control cycle, as upstream
             self.outbox.append((now, CommandSample(linear, angular)))
         separation, left_radius, right_radius = self.wheel_params_applied
