@@ -20,14 +20,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.core.description.model_path import default_model_path
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 HERE = os.path.dirname(os.path.abspath(__file__))
