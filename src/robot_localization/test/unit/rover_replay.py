@@ -11,7 +11,8 @@ from robot_localization.params import read_config
 
 TEST = Path(__file__).resolve().parent.parent
 DATA = TEST / "data" / "rover_drive.npz"
-CLEARPATH_CONFIG = TEST / "clearpath_localization.yaml"
+# The rover's own EKF configuration, which its control.launch loads (Clearpath's husky_control shape).
+CLEARPATH_CONFIG = TEST.parent.parent / "rover_control" / "config" / "localization.yaml"
 
 
 def load_recording():
