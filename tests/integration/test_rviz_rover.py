@@ -1,7 +1,7 @@
 """The rover in rviz with its shipped config (fixed frame odom, as the README shows): drawn at rest, then
 moved in the picture by ``rostopic pub /cmd_vel`` through twist_mux, with no TF errors. The rover runs without
-its 3D lidar and with enable_ekf:=false (the controller's odometry publishes odom -> base_link) until the
-workspace has robot_localization. MBOT_SCREENSHOT_DIR, if set, receives the two screenshots."""
+its 3D lidar; odom -> base_link comes from robot_localization's EKF, as Clearpath's launch has it.
+MBOT_SCREENSHOT_DIR, if set, receives the two screenshots."""
 import os
 import shutil
 import subprocess
@@ -39,8 +39,7 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
         options = yaml.safe_load(stream)["Visualization Manager"]["Global Options"]
     assert options["Fixed Frame"] == "odom"
     background = parse_colour(options["Background Color"])
-    simulation = launch("rover_gazebo", "rover_empty_world.launch", "gui:=false", "lidar_3d_enabled:=false",
-                        "enable_ekf:=false")
+    simulation = launch("rover_gazebo", "rover_empty_world.launch", "gui:=false", "lidar_3d_enabled:=false")
     master = rosgraph.Master("/test_rviz_rover", master_uri=ros_env["ROS_MASTER_URI"])
     wait_until(lambda: published(master) >= TOPICS, 60, f"the rover's {', '.join(sorted(TOPICS))} "
                f"(see {simulation.log_path})")
