@@ -25,6 +25,16 @@ def twist(linear=0.0, angular=0.0) -> Twist:
     return message
 
 
+def publish_for(sim_seconds, *publications):
+    """Each (publisher, message) every 20 ms of wall time for ``sim_seconds`` of sim time: well within the
+    controllers' cmd_vel timeouts (0.25 s and more)."""
+    end = rospy.get_time() + sim_seconds
+    while rospy.get_time() < end:
+        for publisher, message in publications:
+            publisher.publish(message)
+        rospy.rostime.wallsleep(0.02)
+
+
 def print_figures(lines):
     """A test's measurements, one ``figure:`` line each on stderr, where ./mbot test picks them up."""
     print("\n".join([""] + ["figure: " + line for line in lines]), file=sys.stderr)

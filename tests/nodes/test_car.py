@@ -12,7 +12,7 @@ from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, controller_states, print_figures, publish_for, twist, wait_for, yaw_of
 
 WHEELBASE = 0.4
 
@@ -37,12 +37,7 @@ class Car(unittest.TestCase):
         print_figures(cls.figures)
 
     def drive(self, linear, steering, sim_seconds):
-        twist = Twist()
-        twist.linear.x, twist.angular.z = linear, steering
-        end = rospy.get_time() + sim_seconds
-        while rospy.get_time() < end:
-            self.cmd_vel.publish(twist)
-            rospy.rostime.wallsleep(0.02)
+        publish_for(sim_seconds, (self.cmd_vel, twist(linear, steering)))
 
     def test_drives_a_steered_arc_and_reports_it_on_odom(self):
         linear, steering = 0.5, 0.3

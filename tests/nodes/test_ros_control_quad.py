@@ -15,7 +15,7 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from mbot_sim_bridge.processes import stop_process_group
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, controller_states, print_figures, publish_for, twist, wait_for, yaw_of
 
 CONTROLLER = "quad_velocity_controller"
 
@@ -46,13 +46,7 @@ class RosControlQuad(unittest.TestCase):
         return self.get_model_state("quad_base", "world").pose
 
     def drive(self, linear, angular, sim_seconds):
-        """Publish the command every 20 ms of wall time for ``sim_seconds`` of sim time (timeout is 0.25 s)."""
-        twist = Twist()
-        twist.linear.x, twist.angular.z = linear, angular
-        end = rospy.get_time() + sim_seconds
-        while rospy.get_time() < end:
-            self.cmd_vel.publish(twist)
-            rospy.rostime.wallsleep(0.02)
+        publish_for(sim_seconds, (self.cmd_vel, twist(linear, angular)))
 
     def test_drives_forward_at_the_commanded_speed(self):
         self.drive(0.4, 0.0, 1.5)

@@ -90,14 +90,10 @@ class Rover(unittest.TestCase):
         return abs(state.pose.position.z - 0.132) < 0.01 and speed < 0.01
 
     def drive(self, linear, sim_seconds, publisher=None, lateral=0.0):
-        """Publish the command every 20 ms of wall time for ``sim_seconds`` of sim time (the rover's timeout is
-        0.25 s), on the rover's cmd_vel or on ``publisher``."""
-        twist = Twist()
-        twist.linear.x, twist.linear.y = linear, lateral
-        end = rospy.get_time() + sim_seconds
-        while rospy.get_time() < end:
-            (publisher or self.cmd_vel).publish(twist)
-            rospy.rostime.wallsleep(0.02)
+        """The command on the rover's cmd_vel or on ``publisher`` for ``sim_seconds`` of sim time."""
+        command = Twist()
+        command.linear.x, command.linear.y = linear, lateral
+        publish_for(sim_seconds, (publisher or self.cmd_vel, command))
 
     def test_01_imu_reads_gravity_up_at_rest(self):
         # Half a second of readings (50 Hz) once the rover has settled after its landing.

@@ -56,14 +56,6 @@ class RoverTwistMux(unittest.TestCase):
             forward = velocity.linear.x * math.cos(heading) + velocity.linear.y * math.sin(heading)
             cls.truth.append((rospy.get_time(), forward, velocity.angular.z, states.pose[index].position.z))
 
-    def publish_for(self, sim_seconds, *publications):
-        """Each (publisher, message) every 20 ms of wall time for ``sim_seconds`` of sim time."""
-        end = rospy.get_time() + sim_seconds
-        while rospy.get_time() < end:
-            for publisher, message in publications:
-                publisher.publish(message)
-            rospy.rostime.wallsleep(0.02)
-
     def mean_truth(self, since):
         samples = [(forward, turn) for stamp, forward, turn, _ in self.truth if stamp >= since]
         self.assertTrue(samples, "no ground truth since the given time")
@@ -71,19 +63,19 @@ class RoverTwistMux(unittest.TestCase):
                 sum(turn for _, turn in samples) / len(samples))
 
     def test_1_cmd_vel_drives_it_through_twist_mux(self):
-        self.publish_for(1.0, (self.cmd_vel, twist(0.3)))
+        publish_for(1.0, (self.cmd_vel, twist(0.3)))
         start = rospy.get_time()
-        self.publish_for(1.0, (self.cmd_vel, twist(0.3)))
+        publish_for(1.0, (self.cmd_vel, twist(0.3)))
         forward, _ = self.mean_truth(start)
         self.figures.append(f"rover on /cmd_vel through twist_mux at 0.3 m/s: {forward:.3f} m/s")
         self.assertAlmostEqual(forward, 0.3, delta=0.015)
         self.assertEqual(self.mux_out[-1][1], twist(0.3))
 
     def test_2_joystick_overrides_cmd_vel(self):
-        self.publish_for(0.5, (self.cmd_vel, twist(0.3)))
-        self.publish_for(0.5, (self.cmd_vel, twist(0.3)), (self.joystick, twist(0.0, 0.6)))
+        publish_for(0.5, (self.cmd_vel, twist(0.3)))
+        publish_for(0.5, (self.cmd_vel, twist(0.3)), (self.joystick, twist(0.0, 0.6)))
         start = rospy.get_time()
-        self.publish_for(1.0, (self.cmd_vel, twist(0.3)), (self.joystick, twist(0.0, 0.6)))
+        publish_for(1.0, (self.cmd_vel, twist(0.3)), (self.joystick, twist(0.0, 0.6)))
         forward, turn = self.mean_truth(start)
         passed = {(message.linear.x, message.angular.z) for stamp, message in self.mux_out if stamp >= start}
         self.figures.append(f"rover with the joystick (0.6 rad/s) over /cmd_vel (0.3 m/s): {forward:.3f} m/s, "
@@ -93,7 +85,7 @@ class RoverTwistMux(unittest.TestCase):
         self.assertGreater(turn, 0.3)
         # The joystick stops: its input times out after 0.5 s and /cmd_vel passes again.
         released = rospy.get_time()
-        self.publish_for(1.0, (self.cmd_vel, twist(0.3)))
+        publish_for(1.0, (self.cmd_vel, twist(0.3)))
         back = next(stamp for stamp, message in self.mux_out if stamp >= released and message == twist(0.3))
         self.figures.append(f"/cmd_vel passed again {back - released:.2f} s of sim time after the joystick stopped")
         self.assertLess(back - released, 0.5 + 0.2)
@@ -101,12 +93,12 @@ class RoverTwistMux(unittest.TestCase):
     def test_3_e_stop_stops_it_within_0_1_s(self):
         # The controller's deceleration limit (3 m/s^2, Husky's) alone takes 0.05 s from this speed; the rest of
         # the 0.1 s is the way from this node through twist_mux to the simulator.
-        self.publish_for(1.0, (self.cmd_vel, twist(E_STOP_SPEED)))
+        publish_for(1.0, (self.cmd_vel, twist(E_STOP_SPEED)))
         self.assertGreater(self.truth[-1][1], 0.9 * E_STOP_SPEED)
         self.e_stop.publish(Bool(True))
         self.addCleanup(self.e_stop.publish, Bool(False))
         engaged = rospy.get_time()
-        self.publish_for(0.5, (self.cmd_vel, twist(E_STOP_SPEED)))
+        publish_for(0.5, (self.cmd_vel, twist(E_STOP_SPEED)))
         stopped = next(stamp for stamp, forward, _, _ in self.truth
                        if stamp >= engaged and abs(forward) < STOPPED_SPEED)
         # The body rocks a little on its tyres after a hard stop; it must not drive on while /cmd_vel comes.
@@ -119,7 +111,7 @@ class RoverTwistMux(unittest.TestCase):
         self.assertLess(abs(drift), STOPPED_SPEED)
         self.e_stop.publish(Bool(False))
         released = rospy.get_time()
-        self.publish_for(1.0, (self.cmd_vel, twist(E_STOP_SPEED)))
+        publish_for(1.0, (self.cmd_vel, twist(E_STOP_SPEED)))
         self.assertGreater(self.mean_truth(released + 0.5)[0], 0.9 * E_STOP_SPEED,
                            "/cmd_vel should drive once e_stop is false")
 
@@ -128,9 +120,9 @@ class RoverTwistMux(unittest.TestCase):
                                              event_type=InteractiveMarkerFeedback.POSE_UPDATE, pose=Pose())
         feedback.pose.position.x, feedback.pose.orientation.w = 0.25, 1.0
         feedback.header.frame_id = "base_link"
-        self.publish_for(1.0, (self.feedback, feedback))
+        publish_for(1.0, (self.feedback, feedback))
         start = rospy.get_time()
-        self.publish_for(1.0, (self.feedback, feedback))
+        publish_for(1.0, (self.feedback, feedback))
         forward, _ = self.mean_truth(start)
         self.figures.append(f"rover on the twist marker's feedback (x 0.25 m, scale 1): {forward:.3f} m/s")
         self.assertAlmostEqual(forward, 0.25, delta=0.015)
