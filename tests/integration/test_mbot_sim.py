@@ -1,5 +1,6 @@
 """./mbot sim ends with the simulator's exit status when the simulator stops (server_required semantics)."""
 import os
+import re
 import signal
 import subprocess
 
@@ -66,3 +67,18 @@ def test_shell_puts_the_workspace_after_the_users_bashrc(tmp_path):
                             timeout=120)
     assert "workspace python" in result.stdout, result.stdout + result.stderr
     assert "decoy" not in result.stdout
+
+
+def test_every_world_takes_what_mbot_sim_passes_it():
+    """./mbot sim WORLD runs its launch file with gui:=true|false (and an rviz beside it with --rviz): every world
+    the script names resolves to a launch file that declares gui, or ./mbot sim WORLD would refuse to start."""
+    import roslaunch.arg_dump
+    import roslaunch.rlutil
+    with open(MBOT) as script:
+        worlds = re.findall(r"^\s+([a-z_|]+)\) echo (\S+) (\S+\.launch) ;;$", script.read(), re.M)
+    names = [name for names, _, _ in worlds for name in names.split("|")]
+    assert {"empty", "room", "camera", "kinect", "multi", "rover", "holonomic", "tricycle", "stereo", "arm"} <= \
+        set(names)
+    for names, package, launch_file in worlds:
+        path = roslaunch.rlutil.resolve_launch_arguments([package, launch_file])[0]
+        assert "gui" in roslaunch.arg_dump.get_args([path]), f"{names}: {launch_file} takes no gui argument"
