@@ -43,7 +43,7 @@ class EngineWithMbot:
 
 
 @pytest.fixture
-def core_drive(mbot_urdf):
+def engine_mbot(mbot_urdf):
     drive = EngineWithMbot(mbot_urdf)
     yield drive
     drive.close()
@@ -56,8 +56,8 @@ def driven_mbot(tmp_path, urdf):
     return sim, spawned, plugin_of(spawned, DiffDrive)
 
 
-def test_mass_is_what_the_urdf_states(core_drive):
-    client, robot = core_drive.engine.client, core_drive.robot
+def test_mass_is_what_the_urdf_states(engine_mbot):
+    client, robot = engine_mbot.engine.client, engine_mbot.robot
     total = sum(client.getDynamicsInfo(robot.body, index)[0] for index in robot.link_index.values())
     assert total == pytest.approx(20 + 0.5 + 2 + 2, abs=1e-6)
 
@@ -93,15 +93,15 @@ def test_without_the_caster_fix_the_robot_cannot_turn_in_place(mbot_urdf):
         engine.close()
 
 
-def test_spawn_pose_and_reset_world(core_drive, mbot_urdf):
-    engine = core_drive.engine
+def test_spawn_pose_and_reset_world(engine_mbot, mbot_urdf):
+    engine = engine_mbot.engine
     other = engine.spawn_robot(parse_robot(mbot_urdf), "second", pose_from_xyz_rpy((2.0, 1.0, 0.0), (0, 0, 1.0)))
     assert other.root_pose().position == pytest.approx((2.0, 1.0, 0.0), abs=1e-6)
     assert yaw(other.root_pose().orientation) == pytest.approx(1.0)
-    core_drive.spin_wheels((0.3, 0.3), 1.5)
-    assert core_drive.robot.root_pose().position[0] > 0.3
+    engine_mbot.spin_wheels((0.3, 0.3), 1.5)
+    assert engine_mbot.robot.root_pose().position[0] > 0.3
     engine.reset_world()
-    assert core_drive.robot.root_pose().position == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
+    assert engine_mbot.robot.root_pose().position == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
     assert engine.sim_time == pytest.approx(1.5)
     engine.restart()
     assert engine.sim_time == 0.0 and engine.model_names() == []
@@ -110,15 +110,15 @@ def test_spawn_pose_and_reset_world(core_drive, mbot_urdf):
     assert other.root_pose().position == pytest.approx((2.0, 1.0, 0.0), abs=1e-6)
 
 
-def test_duplicate_and_unknown_model_names_are_errors(core_drive, mbot_urdf):
+def test_duplicate_and_unknown_model_names_are_errors(engine_mbot, mbot_urdf):
     with pytest.raises(ModelError, match="model 'mbot' already exists"):
-        core_drive.engine.spawn_robot(parse_robot(mbot_urdf), "mbot")
+        engine_mbot.engine.spawn_robot(parse_robot(mbot_urdf), "mbot")
     with pytest.raises(ModelError, match="model 'ghost' does not exist"):
-        core_drive.engine.remove("ghost")
+        engine_mbot.engine.remove("ghost")
 
 
-def test_lumped_link_pose_is_composed_from_its_fixed_joint(core_drive):
-    assert core_drive.robot.link_world_pose("base_link").position == pytest.approx((0, 0, 0.042), abs=1e-4)
+def test_lumped_link_pose_is_composed_from_its_fixed_joint(engine_mbot):
+    assert engine_mbot.robot.link_world_pose("base_link").position == pytest.approx((0, 0, 0.042), abs=1e-4)
 
 
 def test_two_runs_with_the_same_inputs_are_identical(tmp_path, mbot_urdf):
