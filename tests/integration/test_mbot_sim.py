@@ -1,5 +1,6 @@
 """./mbot sim ends with the simulator's exit status when the simulator stops (server_required semantics)."""
 import os
+import re
 import signal
 import subprocess
 
@@ -66,3 +67,40 @@ def test_shell_puts_the_workspace_after_the_users_bashrc(tmp_path):
                             timeout=120)
     assert "workspace python" in result.stdout, result.stdout + result.stderr
     assert "decoy" not in result.stdout
+
+
+def test_every_world_takes_what_mbot_sim_passes_it():
+    """./mbot sim WORLD runs its launch file with gui:=true|false (and an rviz beside it with --rviz): every world
+    the script names resolves to a launch file that declares gui, or ./mbot sim WORLD would refuse to start."""
+    import roslaunch.arg_dump
+    import roslaunch.rlutil
+    with open(MBOT) as script:
+        worlds = re.findall(r"^\s+([a-z_|]+)\) echo (\S+) (\S+\.launch) ;;$", script.read(), re.M)
+    names = [name for names, _, _ in worlds for name in names.split("|")]
+    assert {"empty", "room", "camera", "kinect", "multi", "rover", "holonomic", "tricycle", "stereo", "arm"} <= \
+        set(names)
+    for names, package, launch_file in worlds:
+        path = roslaunch.rlutil.resolve_launch_arguments([package, launch_file])[0]
+        assert "gui" in roslaunch.arg_dump.get_args([path]), f"{names}: {launch_file} takes no gui argument"
+
+
+def test_teleop_and_rviz_say_to_start_the_simulator_first(tmp_path):
+    environment = _environment(tmp_path)  # a port no master answers on
+    for command in ("teleop", "rviz"):
+        result = run([MBOT, command], environment, timeout=120)
+        assert result.returncode == 1, result.stdout + result.stderr
+        assert "no ROS master" in result.stderr and "start ./mbot sim WORLD first" in result.stderr, result.stderr
+
+
+def test_every_rviz_config_the_wrappers_open_exists():
+    """./mbot rviz CONFIG and ./mbot sim WORLD --rviz open $(rospack find mbot_description)/config/CONFIG.rviz
+    (rover_description's for rover): each config the script names is there."""
+    import rospkg
+    with open(MBOT) as script:
+        text = script.read()
+    rviz_cases = text.split("rviz_config_for() {", 1)[1].split("esac", 1)[0]
+    configs = set(re.findall(r"\) echo (\w+) ;;", rviz_cases)) | {"mbot_with_laser"}  # cmd_rviz's default
+    packages = rospkg.RosPack()
+    for config in configs:
+        package = "rover_description" if config == "rover" else "mbot_description"
+        assert os.path.isfile(os.path.join(packages.get_path(package), "config", config + ".rviz")), config

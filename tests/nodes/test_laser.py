@@ -87,20 +87,22 @@ class Laser(unittest.TestCase):
         set_state = rospy.ServiceProxy("/gazebo/set_model_state", SetModelState)
         state = ModelState(model_name="mbot", reference_frame="world")
         state.pose.orientation.z, state.pose.orientation.w = math.sin(math.pi / 4), math.cos(math.pi / 4)
-        self.assertTrue(set_state(state).success)
-        turned_at = self.sim.truth()[0]
-        scan = self.scans_after(2, start=turned_at)[-1]
-        ranges = numpy.array(scan.ranges)
-        angles = scan.angle_min + numpy.arange(len(ranges)) * scan.angle_increment
-        # The 10 m wall is seen over a span of beams symmetric about its normal; the span's middle is the
-        # wall's direction, which noise cannot move the way it moves a single nearest beam.
-        angle = angles[numpy.isfinite(ranges)].mean()
-        print(f"figure: after a +90 degree turn the wall is centred at {math.degrees(angle):.1f} degrees",
-              file=sys.stderr)
-        # Beams count counter-clockwise from angle_min, so the wall, now on the robot's right, is at -90 degrees.
-        self.assertAlmostEqual(angle, -math.pi / 2, delta=2.5 * scan.angle_increment)
-        state.pose.orientation.z, state.pose.orientation.w = 0.0, 1.0
-        self.assertTrue(set_state(state).success)
+        try:
+            self.assertTrue(set_state(state).success)
+            turned_at = self.sim.truth()[0]
+            scan = self.scans_after(2, start=turned_at)[-1]
+            ranges = numpy.array(scan.ranges)
+            angles = scan.angle_min + numpy.arange(len(ranges)) * scan.angle_increment
+            # The 10 m wall is seen over a span of beams symmetric about its normal; the span's middle is the
+            # wall's direction, which noise cannot move the way it moves a single nearest beam.
+            angle = angles[numpy.isfinite(ranges)].mean()
+            print(f"figure: after a +90 degree turn the wall is centred at {math.degrees(angle):.1f} degrees",
+                  file=sys.stderr)
+            # Beams count counter-clockwise from angle_min, so the wall, now on the robot's right, is at -90 degrees.
+            self.assertAlmostEqual(angle, -math.pi / 2, delta=2.5 * scan.angle_increment)
+        finally:  # the other tests expect the mbot facing the wall, whichever order they run in
+            state.pose.orientation.z, state.pose.orientation.w = 0.0, 1.0
+            self.assertTrue(set_state(state).success)
 
 
 if __name__ == "__main__":

@@ -68,7 +68,7 @@ class MultiMbot(unittest.TestCase):
                   for robot, pose in poses.items()}
         with self.lock:
             scans = dict(self.scans)
-        worst = 0.0
+        worst, compared = 0.0, 0
         for robot in ROBOTS:
             x, y, heading = lasers[robot]
             neighbour = min((other for other in ROBOTS if other != robot),
@@ -81,10 +81,13 @@ class MultiMbot(unittest.TestCase):
             beam = int(round((bearing - scan.angle_min) / scan.angle_increment))
             measured = min(scan.ranges[max(0, beam - 2):beam + 3])
             error = measured - (math.hypot(dx, dy) - LIDAR_RADIUS)
-            worst = max(worst, abs(error))
+            worst, compared = max(worst, abs(error)), compared + 1
             self.assertLess(abs(error), 0.06, f"{robot} sees {neighbour} at {measured:.3f} m along "
                                               f"{bearing:.2f} rad, {error:.3f} m off")
-        print(f"figure: {COUNT} robots: each scan finds its nearest neighbour, worst error {worst:.3f} m")
+        print(f"figure: {COUNT} robots: {compared} scans find their nearest neighbour, worst error {worst:.3f} m")
+        # The fan's blind sector behind is 0.28 rad of the circle: at their spawn headings two robots' neighbours sit
+        # in it (the front of each row), and turning cannot hide half of them.
+        self.assertGreaterEqual(compared, COUNT // 2)
 
     def test_each_robot_drives_on_its_own_cmd_vel(self):
         rates = {robot: 0.1 * (index + 1) * (-1) ** index for index, robot in enumerate(ROBOTS)}

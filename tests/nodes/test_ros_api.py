@@ -2,6 +2,7 @@
 """The bridge exposes gazebo_ros's ROS API (checked against gazebo_api.yaml through rosgraph, not CLI text),
 with one publisher per transform and per joint, and Gazebo's pause and reset behaviour."""
 import collections
+import sys
 import time
 import unittest
 
@@ -11,6 +12,7 @@ import rosservice
 import rostest
 import tf2_ros
 import yaml
+from gazebo_msgs.msg import ModelStates
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
@@ -85,13 +87,42 @@ class RosApi(unittest.TestCase):
             self.assertEqual(joint_senders[joint], {"/gazebo"}, joint)
         self.assertGreater(max(joint_positions["left_wheel_joint"]), 1.0, "the wheels turned while driving")
 
+    def test_model_states_are_every_models_state(self):
+        self.sim.command(0.0, 0.0)
+        wait_for(lambda: abs(self.sim.truth()[2].linear.x) < 1e-3 and abs(self.sim.truth()[2].angular.z) < 1e-3,
+                 what="the mbot at rest")
+        states = rospy.wait_for_message("/gazebo/model_states", ModelStates, timeout=30.0)
+        _, pose, _ = self.sim.truth()
+        self.assertEqual(states.name, self.sim.world_properties().model_names)
+        sent = states.pose[states.name.index("mbot")]
+        for axis in "xyz":
+            self.assertAlmostEqual(getattr(sent.position, axis), getattr(pose.position, axis), delta=1e-3)
+        self.assertAlmostEqual(sent.orientation.z, pose.orientation.z, delta=1e-3)
+
+    def test_the_simulation_keeps_the_worlds_real_time_factor(self):
+        """empty.world's real_time_factor is 1: from a reset of sim time (where the pacing starts again), sim time
+        never runs ahead of wall time (the pacing's slack is 2 ms), and a machine giving the simulator half a core
+        keeps it within half. Counted from the reset, not over a window: after falling behind, the pacing catches
+        up."""
+        start_wall = time.monotonic()
+        self.sim.reset_simulation()
+        end_sim = self.sim.wait_sim_time(3.0)[0]
+        ratio = end_sim / (time.monotonic() - start_wall)
+        print(f"figure: empty world at real_time_factor 1: {ratio:.3f} s of sim time per wall second",
+              file=sys.stderr)
+        self.assertLess(ratio, 1.05)
+        self.assertGreater(ratio, 0.5)
+
     def test_paused_means_no_clock_and_reset_simulation_rewinds_it(self):
         clocks = []
         subscriber = rospy.Subscriber("/clock", Clock, lambda message: clocks.append(message.clock.to_sec()))
         wait_for(lambda: len(clocks) > 10, what="/clock messages")
         self.sim.pause()
         paused_at = len(clocks)
-        time.sleep(0.5)  # a wall-time window in which a running simulator would publish ~50 /clock messages
+        # Twenty answers of the simulator itself, each measured in one of its loop passes: a running simulator
+        # steps between any two of them, a paused one gives one time throughout, and /clock stays put.
+        times = {self.sim.truth()[0] for _ in range(20)}
+        self.assertEqual(len(times), 1, f"sim time went on while paused: {sorted(times)}")
         self.assertLessEqual(len(clocks) - paused_at, 1, "/clock went on while paused")
         self.sim.unpause()
         wait_for(lambda: len(clocks) > paused_at + 10, what="/clock to resume after unpause")

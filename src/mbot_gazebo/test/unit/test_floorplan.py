@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from mbot_gazebo.floorplan import FloorPlanError, load_floor_plan, main, merge_cells, world_sdf
+from mbot_gazebo.floorplan import FloorPlanError, load_floor_plan, main, merge_cells
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
 
@@ -53,7 +53,22 @@ def test_checked_in_room_world_is_the_output_of_its_floor_plan(tmp_path):
 def test_without_an_output_file_the_world_goes_to_standard_output():
     result = run_build_world(ROOM_PLAN)
     assert result.returncode == 0
-    assert result.stdout == world_sdf(load_floor_plan(ROOM_PLAN), "room.yaml")
+    with open(os.path.join(REPO, "worlds", "room.world")) as checked_in:
+        assert result.stdout == checked_in.read()
+
+
+@pytest.mark.parametrize("start, end, expected", [
+    # room.yaml's wall centre lines at x = -2.6, 4.6 and y = -2.6, 2.6, 0.15 m thick: inner faces 0.075 m in.
+    ((0, 0, 0.9), (9, 0, 0.9), (4.525, 0, 0.9)), ((0, 0, 0.9), (-9, 0, 0.9), (-2.525, 0, 0.9)),
+    ((0, 0, 0.9), (0, -9, 0.9), (0, -2.525, 0.9)), ((0, 0, 0.9), (0, 9, 0.9), (0, 2.525, 0.9)),
+    ((4.6, 0, 3), (4.6, 0, -1), (4.6, 0, 1.0)),  # wall_height 1.0
+    ((1.5, 0, 0.5), (1.5, 9, 0.5), None),  # the doorway, x 1.0..2.0 in the north wall
+])
+def test_the_checked_in_room_has_its_walls_where_the_plan_says(client, start, end, expected):
+    """worlds/room.world against the figures of floorplans/room.yaml, not against the tool that wrote it."""
+    load_world(client, parse_world(os.path.join(REPO, "worlds", "room.world"), model_path=[]))
+    hit = ray_hit(client, start, end)
+    assert hit is None if expected is None else hit == pytest.approx(expected, abs=1e-5)
 
 
 def test_walls_stand_where_the_plan_draws_them(tmp_path, client, caplog):

@@ -61,7 +61,16 @@ def test_depth_linearisation_ranges_and_16uc1():
     assert depth[:3] == pytest.approx(z, rel=1e-5) and depth[3] == np.inf
     ranged = depth_in_range(depth, 0.4, 5.0)
     assert np.isnan(ranged[2:]).all() and ranged[0] == pytest.approx(0.5, rel=1e-5)
-    assert depth_16uc1(ranged).tolist() == [500, 1500, 0, 0] or depth_16uc1(ranged).tolist()[2:] == [0, 0]
+    # The float32 depth buffer gives 0.5 m and 1.5 m back a hair short (0.49999997, 1.4999999): Gazebo's
+    # millimetres truncate, so 499 and 1499 (exact depths: test_16uc1_truncates_to_millimetres_and_saturates).
+    assert (depth[:2] < np.float32([0.5, 1.5])).all()
+    assert depth_16uc1(ranged).tolist() == [499, 1499, 0, 0]
+
+
+def test_16uc1_truncates_to_millimetres_and_saturates():
+    """gazebo_ros_openni_kinect stores depth * 1000 into a uint16 (a C conversion: truncation); 0 is no reading."""
+    depth = np.array([0.5, 1.5, 1.2345, 0.0019, np.nan, np.inf, 70.0], dtype=np.float32)
+    assert depth_16uc1(depth).tolist() == [500, 1500, 1234, 1, 0, 0, 65535]
 
 
 def test_point_cloud_layout_and_geometry():
@@ -133,6 +142,12 @@ def test_a_wall_at_1_5_m_in_the_depth_image_and_the_cloud(kinect_urdf, tmp_path)
         kinect = plugin_of(spawned, DepthCamera)
         sim.step(100)
         optical = spawned.robot.link_world_pose("kinect_frame_optical")  # frameName, as TF would give it
+        # Before the wall: the sky and the floor beyond pointCloudCutoffMax (5 m) are NaN, the near floor is not.
+        open_frame = kinect.capture(sim.sim_time)
+        open_depth = kinect.depth_image(open_frame)
+        beyond = np.isfinite(open_frame.depth) & (open_frame.depth >= 5.0)
+        assert np.isnan(open_depth[0]).all() and beyond.any() and np.isnan(open_depth[beyond]).all()
+        assert 0.4 < np.nanmin(open_depth) and np.nanmax(open_depth) < 5.0
         wall_x = optical.position[0] + 1.5
         sim.add_world(world_simulation_description(tmp_path, box("wall", (wall_x + 0.05, 0, 1.0), (0.1, 4, 2))))
         frame = kinect.capture(sim.sim_time)
@@ -153,8 +168,6 @@ def test_a_wall_at_1_5_m_in_the_depth_image_and_the_cloud(kinect_urdf, tmp_path)
         assert worst < 0.01
         assert len(on_wall) > 0.3 * height * width
         assert np.abs(on_wall[:, 1]).max() < 2.0 and on_wall[:, 2].max() < 2.0  # within the wall's extent
-        # Nothing beyond the far clip or the cutoff max is a number.
-        assert np.isnan(depth[0, 0]) or depth[0, 0] < 5.0
     finally:
         sim.close()
 

@@ -68,7 +68,12 @@ def test_the_imu_reads_the_turn_rate(tmp_path):
           f"body {truth:.4f} rad/s")
     assert reading.angular_velocity == pytest.approx((0.0, 0.0, truth), abs=1e-3)
     heading = 2 * math.atan2(reading.orientation[2], reading.orientation[3])
-    assert heading == pytest.approx(0.245, abs=0.01)
+    # 0.5 s at 0.5 rad/s is 0.25 rad, less what the damping took (the rate read above is its measure): the
+    # reading's heading is the body's.
+    orientation = imu.context.robot.root_pose().orientation  # a turn about z only
+    body = 2 * math.atan2(orientation[2], orientation[3])
+    assert 0.5 * truth <= body <= 0.25
+    assert heading == pytest.approx(body, abs=0.01)
 
 
 @pytest.mark.parametrize("heading, north, west", [(0.0, 1.0, 0.0), (90.0, 0.0, -1.0), (30.0, math.cos(math.radians(30)),

@@ -1,6 +1,8 @@
 """core/sensors/imu.py and core/sensors/p3d.py on the course's mbot with an IMU board on a fixed joint (lumped, as
-TurtleBot3's imu_link): at rest, turning at 0.5 rad/s, and against the world pose."""
+TurtleBot3's imu_link): at rest, turning at 0.5 rad/s, and against a pose and velocity given to the model."""
 import logging
+import math
+from xml.etree import ElementTree
 
 import numpy as np
 import pytest
@@ -165,22 +167,29 @@ def test_every_step_imu_is_read_again_soon_after_reset_simulation(mbot_urdf, tmp
         sim.close()
 
 
-def test_p3d_equals_the_world_pose(mbot_urdf, tmp_path):
-    sim, spawned = spawn(tmp_path, with_imu(mbot_urdf))
+def test_p3d_reports_the_pose_and_velocity_the_model_was_given(mbot_urdf, tmp_path):
+    """The model put at a chosen pose and velocity: p3d's base_link is that pose raised by the URDF's
+    base_footprint_joint (read from the URDF text here), its velocity the one given (no rotation, so every point
+    of the body moves alike)."""
+    urdf = with_imu(mbot_urdf)
+    sim, spawned = spawn(tmp_path, urdf)
     try:
         p3d = plugin_of(spawned, P3D)
-        plugin_of(spawned, DiffDrive).set_command(0.3, 0.4)
-        sim.step(2000)
+        sim.step(100)
+        joint_z = float(ElementTree.fromstring(urdf).find("joint[@name='base_footprint_joint']/origin")
+                        .get("xyz").split()[2])
+        heading = 0.8
+        sim.engine.set_model_state("mbot", pose_from_xyz_rpy((1.2, -0.7, 0.4), (0, 0, heading)), (0.3, -0.2, 0.1))
         truth = p3d.read(sim.sim_time)
-        pose = spawned.robot.link_world_pose("base_link")
-        velocity = spawned.robot.link_world_velocity("base_link")
-        position_error = max(abs(a - b) for a, b in zip(truth.pose.position, pose.position))
-        q, r = np.asarray(truth.pose.orientation), np.asarray(pose.orientation)
+        expected_orientation = (0.0, 0.0, math.sin(heading / 2), math.cos(heading / 2))
+        position_error = max(abs(a - b) for a, b in zip(truth.pose.position, (1.2, -0.7, 0.4 + joint_z)))
+        q, r = np.asarray(truth.pose.orientation), np.asarray(expected_orientation)
         angle_error = min(np.abs(q - r).max(), np.abs(q + r).max())  # quaternion components
-        print(f"figure: p3d vs world pose: position error {position_error:.2e} m, quaternion {angle_error:.2e}; "
+        print(f"figure: p3d vs the pose set: position error {position_error:.2e} m, quaternion {angle_error:.2e}; "
               f"frame '{p3d.frame_name}', child '{p3d.child_frame}'")
-        assert position_error < 1e-9 and angle_error < 1e-9
-        assert truth.linear == pytest.approx(velocity[0]) and truth.angular == pytest.approx(velocity[1])
+        assert position_error < 1e-6 and angle_error < 1e-6
+        assert truth.linear == pytest.approx((0.3, -0.2, 0.1), abs=1e-6)
+        assert truth.angular == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
         assert (p3d.frame_name, p3d.child_frame) == ("world", "base_footprint")
     finally:
         sim.close()

@@ -1,5 +1,6 @@
 """joint_trajectory_controller and gripper_action_controller in the simulator, without ROS: the two-joint arm
 (ros_control_test_robots) with the trajectory controller on its position or effort interface."""
+import logging
 import math
 
 import pytest
@@ -175,22 +176,41 @@ def test_the_gripper_reaches_a_free_goal_and_stalls_when_its_effort_cannot_move_
     assert abs(end.effort) <= 0.001
 
 
-@pytest.mark.parametrize("bad", [
-    {"joints": "shoulder"}, {"joints": [1, 2]}, {"joints": []}, {"joints": ["shoulder", "wrist"]},
-    {"state_publish_rate": 0.0}, {"action_monitor_rate": -1.0}, {"state_publish_rate": "fast"},
-    {"constraints": {"goal_time": "soon", "shoulder": {"goal": math.nan}}}, {"stop_trajectory_duration": math.inf},
-    {"gains": {"shoulder": {"p": "high"}, "elbow": {"p": 1.0}}}])
-def test_bad_parameters_refuse_the_controller_or_leave_it_working(bad):
+# Each bad parameter with what the controller manager logs: a refusal (upstream's error), or a warning naming the
+# value and what is used instead, after which the controller works; None where the value is taken as given.
+BAD_PARAMETERS = [
+    ({"joints": "shoulder"}, True, "The 'joints' parameter is not an array (namespace: /arm/arm_controller)."),
+    ({"joints": [1, 2]}, True, "The 'joints' parameter contains a non-string element"),
+    ({"joints": []}, True, "Could not find 'joints' parameter (namespace: /arm/arm_controller)."),
+    ({"joints": ["shoulder", "wrist"]}, True, "Could not find joint 'wrist' in URDF model."),
+    ({"state_publish_rate": 0.0}, False, None),
+    ({"action_monitor_rate": -1.0}, False, None),
+    ({"state_publish_rate": "fast"}, False, "parameter 'state_publish_rate' is 'fast', not a float; using 50.0"),
+    ({"constraints": {"goal_time": "soon", "shoulder": {"goal": math.nan}}}, False,
+     "parameter 'goal_time' is 'soon', not a float; using 0.0"),
+    ({"stop_trajectory_duration": math.inf}, False, "stop_trajectory_duration is inf, not a duration"),
+    ({"gains": {"shoulder": {"p": "high"}, "elbow": {"p": 1.0}}}, True,
+     "/arm/arm_controller/gains/shoulder/p is 'high': a PID gain must be a finite number"),
+]
+
+
+@pytest.mark.parametrize("bad, refused, said", BAD_PARAMETERS)
+def test_bad_parameters_refuse_the_controller_or_leave_it_working(bad, refused, said, caplog):
     config = {"type": "effort_controllers/JointTrajectoryController", "joints": JOINTS, "gains": EFFORT_GAINS,
               **bad}
     sim, _, plugin = simulate(expand_xacro_arm("Effort"), {"arm_controller": config}, "arm")
-    if plugin.manager.load("arm_controller", plugin.urdf):
-        controller = plugin.manager.find("arm_controller").controller
-        assert switch(sim, plugin.manager, ["arm_controller"])
-        controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([0.3, 0.3], time_from_start=0.5)]))
-        controller.cancel_goal(None)
-        sim.step(1000)
-        assert all(math.isfinite(joint.position) for joint in controller.joints)
+    caplog.set_level(logging.WARNING)
+    assert plugin.manager.load("arm_controller", plugin.urdf) is not refused
+    if said is not None:
+        assert said in caplog.text
+    if refused:
+        assert "Initializing controller 'arm_controller' failed" in caplog.text
+        return
+    controller = plugin.manager.find("arm_controller").controller
+    assert switch(sim, plugin.manager, ["arm_controller"])
+    controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([0.3, 0.3], time_from_start=0.5)]))
+    sim.step(1000)
+    assert [joint.position for joint in controller.joints] == pytest.approx([0.3, 0.3], abs=0.02)
 
 
 def test_a_partial_goal_moves_its_joints_only_when_allowed():

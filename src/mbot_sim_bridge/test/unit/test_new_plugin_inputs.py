@@ -1,7 +1,8 @@
 """NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
 tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d, mimic
-joints): each value is refused with one line, or runs without an exception, and a robot two metres away does not
-move by 1 mm."""
+joints): each value is refused with one line naming the tag, or runs without an exception, and a robot two metres
+away does not move by 1 mm. Every edit is checked to have changed the robot: a tag the robot lacks is added to the
+plugins that read it."""
 import math
 import os
 import re
@@ -15,6 +16,7 @@ from plugin_robots import (BUMPER_LUMPED_COLLISION, BUMPER_ROBOT, HECTOR_ROBOT, 
 
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.robot_description import expand_xacro
 
@@ -29,18 +31,43 @@ BYSTANDER = """<robot name="crate"><link name="crate"><inertial><mass value="1"/
   <collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link></robot>"""
 
 
-def run(tmp_path, urdf, command=None, steps=300):
-    """Spawn ``urdf`` beside a dynamic crate, send ``command`` to its drive, step: the crate's displacement, or
-    None when the spawn was refused (ConfigError/ModelError with one line)."""
+def with_tag(urdf, tag, value, plugin_files=()):
+    """``urdf`` with every ``<tag>`` set to ``value``; where it has none, the tag added to the plugins of
+    ``plugin_files``. Fails when nothing changed, so that no case runs the unmodified robot."""
+    edited, count = re.subn(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{value}</{tag}>", urdf)
+    if count == 0:
+        for filename in plugin_files:
+            edited, added = re.subn(f'(<plugin [^>]*filename="{re.escape(filename)}"[^>]*>)',
+                                    rf"\1<{tag}>{value}</{tag}>", edited)
+            count += added
+    assert count > 0 and edited != urdf, f"<{tag}> is in none of {plugin_files or 'the robot'}: the edit did nothing"
+    return edited
+
+
+def assert_refused_or_harmless(outcome, tag, text):
+    """A refusal is one line naming the tag and the value (as written or as the number read); a run leaves the
+    bystander within 1 mm."""
+    if isinstance(outcome, str):
+        assert "\n" not in outcome and f"{tag}>" in outcome, outcome
+        assert text in outcome or f"{float(text):g}" in outcome, outcome
+    else:
+        assert outcome < 1e-3
+
+
+def run(tmp_path, urdf, command=None, steps=300, parameters=None):
+    """Spawn ``urdf`` beside a dynamic crate (with ``parameters`` on the parameter server), send ``command`` to its
+    drive, step: the crate's displacement, or the refusal's text when the spawn was refused (ConfigError/ModelError)."""
     sim = world_simulation(tmp_path, box("wall", (1.2, 0.0, 0.5), (0.1, 4.0, 1.0)))
+    if parameters is not None:
+        sim.parameters = parameters
     try:
         sim.spawn_robot(parse_robot(BYSTANDER, "model 'crate'"), "crate", pose_from_xyz_rpy((2, 2, 0.15), (0, 0, 0)))
         sim.step(100)
         start = sim.engine.model_pose("crate").position
         try:
             spawned = sim.spawn_robot(parse_robot(urdf, "model 'robot'"), "robot")
-        except BridgeError:
-            return None
+        except BridgeError as refusal:
+            return str(refusal)
         if command is not None:
             for plugin in spawned.plugins:
                 if hasattr(plugin, "set_command"):
@@ -62,18 +89,25 @@ def velodyne_urdf(tmp_path_factory):
     return expand_xacro(str(path))
 
 
+VELODYNE_FILES = ("libgazebo_ros_velodyne_laser.so",)
+VELODYNE_TAGS = ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples"]
+
+
 @pytest.mark.parametrize("text", BAD_TEXTS)
-@pytest.mark.parametrize("tag", ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples"])
+@pytest.mark.parametrize("tag", VELODYNE_TAGS)
 def test_velodyne_tags(tmp_path, velodyne_urdf, tag, text):
-    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", velodyne_urdf)
-    moved = run(tmp_path, urdf)
-    assert moved is None or moved < 1e-3
+    urdf = with_tag(velodyne_urdf, tag, text, VELODYNE_FILES)
+    assert_refused_or_harmless(run(tmp_path, urdf), tag, text)
 
 
 @pytest.fixture(scope="module")
 def drives():
     return {"planar": expand_xacro(HOLONOMIC_XACRO),
             "skid": expand_xacro(SKID_XACRO)}
+
+
+DRIVE_TAGS = [("skid", "torque"), ("skid", "wheelDiameter"), ("skid", "wheelSeparation"), ("skid", "updateRate"),
+              ("skid", "covariance_yaw"), ("planar", "odometryRate"), ("planar", "cmdTimeout")]
 
 
 @pytest.mark.parametrize("value", BAD_VALUES)
@@ -86,22 +120,22 @@ def test_drive_commands(tmp_path, drives, drive, axis, value):
 
 
 @pytest.mark.parametrize("text", BAD_TEXTS)
-@pytest.mark.parametrize("drive, tag", [("skid", "torque"), ("skid", "wheelDiameter"), ("skid", "wheelSeparation"),
-                                        ("skid", "updateRate"), ("skid", "covariance_yaw"),
-                                        ("planar", "odometryRate"), ("planar", "cmdTimeout")])
+@pytest.mark.parametrize("drive, tag", DRIVE_TAGS)
 def test_drive_tags(tmp_path, drives, drive, tag, text):
-    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", drives[drive])
+    urdf = with_tag(drives[drive], tag, text)
     command = (lambda plugin: plugin.set_command(0.5, 0.0, 0.5)) if drive == "planar" else (
         lambda plugin: plugin.set_command(0.5, 0.5))
-    moved = run(tmp_path, urdf, command)
-    assert moved is None or moved < 1e-3
+    assert_refused_or_harmless(run(tmp_path, urdf, command), tag, text)
 
 
 SONARS = (SONAR_SENSOR.format(name="front", plugin=RANGE_PLUGIN.format(radiation="ultrasound", noise=0))
           + SONAR_SENSOR.format(name="rear", plugin=HECTOR_SONAR_PLUGIN.format(noise=0)))
 SENSOR_ROBOTS = {"hector": HECTOR_ROBOT.format(heading=0, imu="", gps=""), "sonar": SONAR_ROBOT.format(sensors=SONARS),
                  "bumper": BUMPER_ROBOT.format(collision=BUMPER_LUMPED_COLLISION)}
-HECTOR_FILES = ("libhector_gazebo_ros_imu.so", "libhector_gazebo_ros_gps.so", "libhector_gazebo_ros_magnetic.so")
+# Where a tag the robot lacks goes: the plugins that read it.
+SENSOR_FILES = {"hector": ("libhector_gazebo_ros_imu.so", "libhector_gazebo_ros_gps.so",
+                           "libhector_gazebo_ros_magnetic.so"),
+                "sonar": ("libgazebo_ros_range.so", "libhector_gazebo_ros_sonar.so"), "bumper": ()}
 SENSOR_TAGS = [("hector", tag) for tag in ("updateRate", "gaussianNoise", "magnitude", "inclination", "declination",
                                            "referenceHeading", "referenceLatitude", "referenceAltitude", "accelDrift",
                                            "rateDriftFrequency", "driftFrequency", "scaleError", "offset",
@@ -116,14 +150,8 @@ VECTOR_TAGS = {"accelDrift", "rateDriftFrequency", "driftFrequency", "scaleError
 @pytest.mark.parametrize("robot, tag", SENSOR_TAGS)
 def test_sensor_tags(tmp_path, robot, tag, text):
     value = " ".join([text] * 3) if tag in VECTOR_TAGS else text
-    urdf = SENSOR_ROBOTS[robot]
-    if f"<{tag}>" in urdf:
-        urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{value}</{tag}>", urdf)
-    else:
-        for filename in HECTOR_FILES:
-            urdf = urdf.replace(f'filename="{filename}">', f'filename="{filename}"><{tag}>{value}</{tag}>')
-    moved = run(tmp_path, urdf)
-    assert moved is None or moved < 1e-3
+    urdf = with_tag(SENSOR_ROBOTS[robot], tag, value, SENSOR_FILES[robot])
+    assert_refused_or_harmless(run(tmp_path, urdf), tag, text)
 
 
 @pytest.fixture(scope="module")
@@ -139,14 +167,17 @@ def test_tricycle_commands(tmp_path, tricycle, axis, value):
     assert run(tmp_path, tricycle, lambda plugin: plugin.set_command(*command)) < 1e-3
 
 
+TRICYCLE_FILES = ("libgazebo_ros_tricycle_drive.so",)
+TRICYCLE_TAGS = ["actuatedWheelDiameter", "encoderWheelDiameter", "encoderWheelSeparation", "wheelTorque",
+                 "updateRate", "wheelAcceleration", "wheelSpeedTolerance", "steeringSpeed", "steeringAngleTolerance",
+                 "gaussianNoise", "samples", "min", "max"]
+
+
 @pytest.mark.parametrize("text", TAG_TEXTS)
-@pytest.mark.parametrize("tag", ["actuatedWheelDiameter", "encoderWheelDiameter", "encoderWheelSeparation",
-                                 "wheelTorque", "updateRate", "wheelAcceleration", "wheelSpeedTolerance",
-                                 "steeringSpeed", "steeringAngleTolerance", "gaussianNoise", "samples", "min", "max"])
+@pytest.mark.parametrize("tag", TRICYCLE_TAGS)
 def test_tricycle_and_block_laser_tags(tmp_path, tricycle, tag, text):
-    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", tricycle)
-    moved = run(tmp_path, urdf, lambda plugin: plugin.set_command(0.3, 0.2))
-    assert moved is None or moved < 1e-3
+    urdf = with_tag(tricycle, tag, text, TRICYCLE_FILES)
+    assert_refused_or_harmless(run(tmp_path, urdf, lambda plugin: plugin.set_command(0.3, 0.2)), tag, text)
 
 
 @pytest.fixture(scope="module")
@@ -154,15 +185,17 @@ def stereo_head():
     return expand_xacro(STEREO_XACRO, rate="50")
 
 
+STEREO_FILES = ("libgazebo_ros_ft_sensor.so",)
+STEREO_TAGS = ["horizontal_fov", "width", "near", "far", "hackBaseline", "updateRate", "gaussianNoise", "pose"]
+
+
 @pytest.mark.parametrize("text", TAG_TEXTS)
-@pytest.mark.parametrize("tag", ["horizontal_fov", "width", "near", "far", "hackBaseline", "updateRate",
-                                 "gaussianNoise", "pose"])
+@pytest.mark.parametrize("tag", STEREO_TAGS)
 def test_stereo_head_tags(tmp_path, stereo_head, tag, text):
     """The multicamera's, the ft sensor's (gaussianNoise, updateRate) and the f3d's inputs."""
     value = " ".join([text] * 6) if tag == "pose" else text
-    urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{value}</{tag}>", stereo_head)
-    moved = run(tmp_path, urdf)
-    assert moved is None or moved < 1e-3
+    urdf = with_tag(stereo_head, tag, value, STEREO_FILES)
+    assert_refused_or_harmless(run(tmp_path, urdf), tag, text)
 
 
 @pytest.mark.parametrize("text", TAG_TEXTS)
@@ -172,13 +205,26 @@ def test_mimic_tags(tmp_path, tag, text):
                                        else f"<{tag}>{text}</{tag}>")
     urdf = MIMIC_GRIPPER.format(mimic="", plugin=plugin.replace("<multiplier>-1</multiplier>", "")
                           .replace("<offset>0.002</offset>", "") if tag in ("multiplier", "offset") else plugin)
-    moved = run(tmp_path, urdf)
-    assert moved is None or moved < 1e-3
+    assert f"<{tag}>{text}</{tag}>" in urdf
+    # maxEffort clamps the PID's effort: the PID needs gains, else the spawn is refused for want of them.
+    gains = Parameters({"gazebo_ros_control": {"pid_gains": {"right_finger_joint": {"p": 2000.0, "d": 20.0}}}})
+    assert_refused_or_harmless(run(tmp_path, urdf, parameters=gains), tag, text)
 
 
 @pytest.mark.parametrize("text", TAG_TEXTS)
 @pytest.mark.parametrize("attribute", ["multiplier", "offset"])
 def test_urdf_mimic_attributes(tmp_path, attribute, text):
     mimic = f'<mimic joint="left_finger_joint" {attribute}="{text}"/>'
-    moved = run(tmp_path, MIMIC_GRIPPER.format(mimic=mimic, plugin=""))
-    assert moved is None or moved < 1e-3
+    assert_refused_or_harmless(run(tmp_path, MIMIC_GRIPPER.format(mimic=mimic, plugin="")), attribute, text)
+
+
+def test_every_tag_edit_changes_the_robot(velodyne_urdf, drives, tricycle, stereo_head):
+    """The class of case that ran the unmodified robot and passed cannot come back: every parametrized edit of
+    this module puts the bad value into the robot's text."""
+    cases = ([(velodyne_urdf, tag, VELODYNE_FILES) for tag in VELODYNE_TAGS]
+             + [(drives[drive], tag, ()) for drive, tag in DRIVE_TAGS]
+             + [(SENSOR_ROBOTS[robot], tag, SENSOR_FILES[robot]) for robot, tag in SENSOR_TAGS]
+             + [(tricycle, tag, TRICYCLE_FILES) for tag in TRICYCLE_TAGS]
+             + [(stereo_head, tag, STEREO_FILES) for tag in STEREO_TAGS])
+    for urdf, tag, files in cases:
+        assert f"<{tag}>-7.25</{tag}>" in with_tag(urdf, tag, "-7.25", files)

@@ -1,6 +1,5 @@
 """Velodyne's lidar plugins (core/sensors/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
 in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
-import math
 import os
 
 import numpy as np
@@ -78,4 +77,11 @@ def test_the_pointcloud2_layout_is_velodyne_pointclouds():
     assert [(f.name, f.offset, f.datatype) for f in FIELDS] == [
         ("x", 0, 7), ("y", 4, 7), ("z", 8, 7), ("intensity", 12, 7), ("ring", 16, 4), ("time", 18, 7)]
     assert POINT.itemsize == 22
-    assert math.isclose(np.frombuffer(np.zeros(1, POINT).tobytes(), np.uint8).size, 22)
+    # A point packed as the plugin packs it reads back through sensor_msgs' own reader of those fields.
+    from sensor_msgs import point_cloud2
+    from sensor_msgs.msg import PointCloud2
+    point = np.zeros(1, POINT)
+    point["x"], point["y"], point["z"], point["intensity"], point["ring"], point["time"] = 1.5, -2.25, 0.125, 7, 13, 0.5
+    message = PointCloud2(height=1, width=1, fields=FIELDS, is_bigendian=False, point_step=POINT.itemsize,
+                          row_step=POINT.itemsize, data=point.tobytes(), is_dense=True)
+    assert list(point_cloud2.read_points(message)) == [(1.5, -2.25, 0.125, 7.0, 13, 0.5)]

@@ -1,5 +1,6 @@
-"""A second /joint_states publisher beside the simulator (the course's joint_state_publisher) is reported once,
-naming the node, what it sends and the launch-file fix; the simulator's own messages raise nothing."""
+"""publisher_check: a second /joint_states publisher beside the simulator's (the course's joint_state_publisher) is
+reported once, naming the node, what it sends and the launch-file fix; the loop's own messages raise nothing. The
+check runs in publisher_check_loop.py, a node that calls it as the bridge's loop does."""
 import os
 import subprocess
 import sys
@@ -9,7 +10,7 @@ from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, run, wait_until
 
-SIMULATOR = os.path.join(TESTS, "integration", "joint_states_simulator.py")
+CHECK_LOOP = os.path.join(TESTS, "integration", "publisher_check_loop.py")
 URDF = """<robot name="mbot"><link name="base_link"/>
   <link name="left_wheel_link"/><link name="right_wheel_link"/><link name="back_caster_link"/>
   <joint name="left_wheel_joint" type="continuous"><parent link="base_link"/><child link="left_wheel_link"/></joint>
@@ -41,13 +42,13 @@ SENDS = {"true": "zero positions for left_wheel_joint, right_wheel_joint, back_c
 @pytest.mark.parametrize("default_positions", sorted(SENDS))
 def test_second_joint_states_publisher_is_reported_once(ros_env, processes, default_positions):
     assert run(["rosparam", "set", "robot_description", URDF], ros_env).returncode == 0
-    simulator_log = processes("simulator", [sys.executable, SIMULATOR])
+    loop_log = processes("check_loop", [sys.executable, CHECK_LOOP])
     processes("joint_state_publisher", ["rosrun", "joint_state_publisher", "joint_state_publisher",
                                         "_publish_default_positions:=" + default_positions])
-    wait_until(lambda: "second publisher" in simulator_log.read_text(), 60, "the simulator's warning")
+    wait_until(lambda: "second publisher" in loop_log.read_text(), 60, "the check's warning")
     # Three more checks go by without a second warning.
-    wait_until(lambda: _checks_after_warning(simulator_log.read_text()) >= 3, 60, "three more checks")
-    text = simulator_log.read_text()
+    wait_until(lambda: _checks_after_warning(loop_log.read_text()) >= 3, 60, "three more checks")
+    text = loop_log.read_text()
     assert text.count("second publisher") == 1, text
     line = next(line for line in text.splitlines() if "second publisher" in line)
     assert "/joint_states has a second publisher, node /joint_state_publisher" in line

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Stand-in for the simulator's joint_states side: node 'gazebo' publishes the mbot's moving joints at 100 Hz
-and calls check_joint_state_publishers on every pass, as the bridge's loop does."""
+"""publisher_check's loop without the simulator: node 'gazebo' publishes the mbot's moving joints at 100 Hz and
+calls check_joint_state_publishers on every pass, as the bridge's loop (node.py) does; it prints a line each time a
+check starts, which the simulator does not, so that the test can count the checks after the warning."""
 import time
 
 import rospy
