@@ -22,7 +22,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
-from sim_support import WALL_TIMEOUT, print_figures, wait_for, wait_for_running_controllers
+from sim_support import WALL_TIMEOUT, print_figures, publish_for, wait_for, wait_for_running_controllers
 
 CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).

@@ -14,7 +14,7 @@ from geometry_msgs.msg import Pose, Twist
 from std_msgs.msg import Bool
 from visualization_msgs.msg import InteractiveMarkerFeedback
 
-from sim_support import print_figures, twist, wait_for, wait_for_running_controllers, yaw_of
+from sim_support import print_figures, publish_for, twist, wait_for, wait_for_running_controllers, yaw_of
 
 CONTROLLER = "rover_velocity_controller"
 # The e-stop's limit, and what "stopped" means for the ground truth: the rover's speed (m/s).
