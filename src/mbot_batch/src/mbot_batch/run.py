@@ -1,0 +1,223 @@
+"""One run, in a process of its own: ``python3 -m mbot_batch.run RUN.json FOLDER [--gui] [--rviz]``.
+
+It starts a private ROS master on a free port, sets the run's ROS parameters, then either the launch file (in
+lockstep, with the run's seed) and the Python scenario that drives it, or ``rostest`` against that master. Every
+process of the run has ROS_HOME, ROS_LOG_DIR and TMPDIR in FOLDER, and carries the run's token in its environment
+(``MBOT_BATCH_RUN``): roslaunch starts each node in a session of its own, so a process group does not hold a run,
+and the token finds every process of it, even one whose parent died. At the timeout, on SIGINT/SIGTERM, when
+the process that started this one dies (a worker killed), and at the end, every process with the token is
+killed. What it saw goes to FOLDER/raw.json; the logs to FOLDER/logs/.
+"""
+import argparse
+import glob
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from xml.etree import ElementTree
+
+from .results import parse_metrics
+from .spec import Run
+
+TOKEN_VARIABLE = "MBOT_BATCH_RUN"
+POLL_SECONDS = 0.05
+
+
+def processes_with_token(prefix: str, exclude=()) -> list:
+    """Pids whose environment holds a run token starting with ``prefix``."""
+    wanted = f"{TOKEN_VARIABLE}={prefix}".encode()
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit() or int(entry) in exclude:
+            continue
+        try:
+            with open(f"/proc/{entry}/environ", "rb") as stream:
+                if any(variable.startswith(wanted) for variable in stream.read().split(b"\0")):
+                    found.append(int(entry))
+        except OSError:
+            continue  # gone, or not ours to read
+    return found
+
+
+def kill_token(prefix: str, exclude=(), rounds: int = 50) -> int:
+    """SIGKILL every process whose token starts with ``prefix``, again until none is left (one may have started
+    a child meanwhile); returns how many were killed."""
+    killed = set()
+    for _ in range(rounds):
+        pids = [pid for pid in processes_with_token(prefix, exclude) if pid not in killed or _alive(pid)]
+        if not pids:
+            break
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+                killed.add(pid)
+            except ProcessLookupError:
+                pass
+        time.sleep(0.01)
+    return len(killed)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as stream:
+            return stream.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+class RunProcesses:
+    def __init__(self, run: Run, folder: str, gui: bool, rviz: bool):
+        self.run = run
+        self.folder = folder
+        self.gui, self.rviz = gui, rviz
+        self.logs = os.path.join(folder, "logs")
+        os.makedirs(self.logs, exist_ok=True)
+        home = os.path.join(folder, "ros_home")
+        temporary = os.path.join(folder, "tmp")
+        os.makedirs(temporary, exist_ok=True)
+        os.environ.update(ROS_HOME=home, ROS_LOG_DIR=os.path.join(home, "log"), TMPDIR=temporary,
+                          PYTHONUNBUFFERED="1")
+        self.stop_reason = None
+
+    def log(self, name: str):
+        return open(os.path.join(self.logs, name), "w")
+
+    def start(self, command, log_name, environment=None):
+        with self.log(log_name) as log:
+            return subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=environment or os.environ)
+
+    def launch_arguments(self):
+        arguments = dict(self.run.launch_args, lockstep="true", seed=str(self.run.seed))
+        if self.gui:
+            arguments["gui"] = "true"
+        elif "gui" in _declared(self.run.launch_path or self.run.rostest_path):
+            arguments.setdefault("gui", "false")
+        return [f"{name}:={value}" for name, value in arguments.items()]
+
+    def execute(self, deadline: float, watch_parent: int, token: str) -> dict:
+        from mbot_sim_bridge.processes import PrivateMaster
+        raw = {"timeout": self.run.timeout, "timed_out": False, "error": None, "exit_code": None, "metrics": {}}
+        with PrivateMaster(timeout=max(1.0, deadline - time.monotonic())) as master:
+            os.environ["ROS_MASTER_URI"] = master.uri
+            try:
+                self.set_parameters()
+                main_log, main, companions = self.start_run()
+                ended = self.wait(main, companions, deadline, watch_parent)
+            finally:
+                # The metrics are out: the run's processes are killed at once rather than stopped in turn, which
+                # took seconds per run under load. Its master too, then reaped by PrivateMaster.
+                kill_token(token, exclude=(os.getpid(),))
+            if ended == "timeout":
+                raw["timed_out"] = True
+            elif ended == "companion":
+                raw["error"] = f"the launch ended (status {companions[0].returncode}) before the scenario"
+            elif ended == "done":
+                raw["exit_code"] = main.returncode
+        with open(os.path.join(self.logs, main_log), errors="replace") as stream:
+            raw["metrics"] = parse_metrics(stream.read())
+        if self.run.rostest_path:
+            raw["rostest"] = self.rostest_counts()
+        return raw
+
+    def start_run(self):
+        """The run's processes: rostest, or the launch file and the scenario (and rviz); (main log, main process,
+        companions whose end before the main one's is an error)."""
+        if self.run.rostest_path:
+            main = self.start(["rostest", "--reuse-master", "--text", self.run.rostest_path,
+                               *self.launch_arguments()], "rostest.log")
+            return "rostest.log", main, []
+        launch = self.start(["roslaunch", self.run.launch_path, *self.launch_arguments()], "launch.log")
+        environment = dict(os.environ, MBOT_BATCH_PARAMETERS=json.dumps(self.run.scenario_params))
+        main = self.start([sys.executable, self.run.python_path], "scenario.log", environment)
+        companions = [launch]
+        if self.rviz:
+            companions.append(self.start(["rosrun", "rviz", "rviz", "-d", _rviz_config()], "rviz.log"))
+        return "scenario.log", main, companions
+
+    def set_parameters(self):
+        import rosgraph
+        master = rosgraph.Master("/mbot_batch")
+        for name, value in self.run.ros_params.items():
+            master.setParam(name, value)
+
+    def wait(self, main, companions, deadline, watch_parent) -> str:
+        while True:
+            if main.poll() is not None:
+                return "done"
+            if self.stop_reason:
+                return self.stop_reason
+            if os.getppid() != watch_parent:
+                self.stop_reason = "orphaned"
+                return "orphaned"
+            if time.monotonic() > deadline:
+                return "timeout"
+            if companions and companions[0].poll() is not None:
+                return "companion"
+            time.sleep(POLL_SECONDS)
+
+    def rostest_counts(self) -> dict:
+        tests = failed = 0
+        for path in glob.glob(os.path.join(os.environ["ROS_HOME"], "test_results", "**", "*.xml"), recursive=True):
+            try:
+                root = ElementTree.parse(path).getroot()
+            except ElementTree.ParseError:
+                continue
+            for suite in ([root] if root.tag == "testsuite" else root.iter("testsuite")):
+                tests += int(suite.get("tests", 0))
+                failed += int(suite.get("failures", 0)) + int(suite.get("errors", 0))
+            with open(path) as source, self.log("rostest-" + os.path.basename(path)) as copy:
+                copy.write(source.read())
+        return {"tests": tests, "failed": failed}
+
+
+def _declared(path: str):
+    import roslaunch.arg_dump
+    return roslaunch.arg_dump.get_args([path])
+
+
+def _rviz_config() -> str:
+    import rospkg
+    return os.path.join(rospkg.RosPack().get_path("mbot_description"), "config", "mbot_with_laser.rviz")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python3 -m mbot_batch.run", description=__doc__.splitlines()[0])
+    parser.add_argument("run_file")
+    parser.add_argument("folder")
+    parser.add_argument("--gui", action="store_true")
+    parser.add_argument("--rviz", action="store_true")
+    args = parser.parse_args(argv)
+    started = time.monotonic()
+    with open(args.run_file) as stream:
+        run = Run.from_dict(json.load(stream))
+    watch_parent = os.getppid()
+    token = os.environ.get(TOKEN_VARIABLE)
+    if not token:
+        print(f"mbot_batch.run: {TOKEN_VARIABLE} is not set", file=sys.stderr)
+        return 2
+    processes = RunProcesses(run, args.folder, args.gui, args.rviz)
+
+    def request_stop(signum, _frame):
+        processes.stop_reason = "stopped"
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
+    try:
+        raw = processes.execute(started + run.timeout, watch_parent, token)
+    except (RuntimeError, OSError) as error:
+        raw = {"timeout": run.timeout, "timed_out": False, "error": f"the run could not start: {error}",
+               "metrics": {}}
+    finally:
+        kill_token(token, exclude=(os.getpid(),))  # also when the start failed half-way
+    raw["wall_seconds"] = time.monotonic() - started
+    if processes.stop_reason:
+        return 1  # stopped from outside: nothing to report
+    with open(os.path.join(args.folder, "raw.json.tmp"), "w") as stream:
+        json.dump(raw, stream)
+    os.replace(os.path.join(args.folder, "raw.json.tmp"), os.path.join(args.folder, "raw.json"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
