@@ -1,8 +1,9 @@
 """The example's scenario: the lidar mbot drives ./mbot demo's tour of the play ground from the run's start pose
-(the launch file's x, y, Y), steering on /odom as the demo does, and reports the distance it drove, the smallest lidar range it saw (its clearance
-to the nearest obstacle, with the run's lidar noise), whether it finished the tour and the sim time it took.
+(the launch file's x, y, Y), steering on /odom as the demo does, and reports the distance it drove, the smallest
+lidar range it saw (its clearance to the nearest obstacle, with the run's lidar noise), whether it finished the
+tour and the sim time it took.
 
-A tour leg that makes no progress for 15 s of sim time (the robot pushed against an obstacle) ends the tour."""
+A tour leg not done within 15 s of sim time (the robot pushed against an obstacle) ends the tour early."""
 import math
 
 import numpy

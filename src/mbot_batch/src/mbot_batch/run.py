@@ -6,7 +6,7 @@ process of the run has ROS_HOME, ROS_LOG_DIR and TMPDIR in FOLDER, and carries t
 (``MBOT_BATCH_RUN``): roslaunch starts each node in a session of its own, so a process group does not hold a run,
 and the token finds every process of it, even one whose parent died. At the timeout, on SIGINT/SIGTERM, when
 the process that started this one dies (a worker killed), and at the end, every process with the token is
-killed. What it saw goes to FOLDER/raw.json; the logs to FOLDER/logs/.
+killed at once. What it saw goes to FOLDER/raw.json; the logs to FOLDER/logs/.
 """
 import argparse
 import glob
@@ -15,6 +15,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from xml.etree import ElementTree
 
@@ -79,7 +80,6 @@ class RunProcesses:
         os.makedirs(temporary, exist_ok=True)
         os.environ.update(ROS_HOME=home, ROS_LOG_DIR=os.path.join(home, "log"), TMPDIR=temporary,
                           PYTHONUNBUFFERED="1")
-        self.stop_reason = None
 
     def log(self, name: str):
         return open(os.path.join(self.logs, name), "w")
@@ -96,7 +96,7 @@ class RunProcesses:
             arguments.setdefault("gui", "false")
         return [f"{name}:={value}" for name, value in arguments.items()]
 
-    def execute(self, deadline: float, watch_parent: int, token: str) -> dict:
+    def execute(self, deadline: float, token: str) -> dict:
         from mbot_sim_bridge.processes import PrivateMaster
         raw = {"timeout": self.run.timeout, "timed_out": False, "error": None, "exit_code": None, "metrics": {}}
         with PrivateMaster(timeout=max(1.0, deadline - time.monotonic())) as master:
@@ -104,7 +104,7 @@ class RunProcesses:
             try:
                 self.set_parameters()
                 main_log, main, companions = self.start_run()
-                ended = self.wait(main, companions, deadline, watch_parent)
+                ended = self.wait(main, companions, deadline)
             finally:
                 # The metrics are out: the run's processes are killed at once rather than stopped in turn, which
                 # took seconds per run under load. Its master too, then reaped by PrivateMaster.
@@ -142,15 +142,11 @@ class RunProcesses:
         for name, value in self.run.ros_params.items():
             master.setParam(name, value)
 
-    def wait(self, main, companions, deadline, watch_parent) -> str:
+    @staticmethod
+    def wait(main, companions, deadline) -> str:
         while True:
             if main.poll() is not None:
                 return "done"
-            if self.stop_reason:
-                return self.stop_reason
-            if os.getppid() != watch_parent:
-                self.stop_reason = "orphaned"
-                return "orphaned"
             if time.monotonic() > deadline:
                 return "timeout"
             if companions and companions[0].poll() is not None:
@@ -182,6 +178,24 @@ def _rviz_config() -> str:
     return os.path.join(rospkg.RosPack().get_path("mbot_description"), "config", "mbot_with_laser.rviz")
 
 
+def end_with_parent_or_signal(token: str):
+    """Kill the run and end this process at once on SIGINT/SIGTERM or when the process that started it dies (a
+    worker killed, a driver gone), whatever this process is doing: starting the master, waiting, stopping."""
+    parent = os.getppid()
+
+    def end(*_):
+        kill_token(token, exclude=(os.getpid(),))
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(POLL_SECONDS)
+        end()
+    signal.signal(signal.SIGINT, end)
+    signal.signal(signal.SIGTERM, end)
+    threading.Thread(target=watch, name="parent watch", daemon=True).start()
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m mbot_batch.run", description=__doc__.splitlines()[0])
     parser.add_argument("run_file")
@@ -190,29 +204,22 @@ def main(argv=None):
     parser.add_argument("--rviz", action="store_true")
     args = parser.parse_args(argv)
     started = time.monotonic()
-    with open(args.run_file) as stream:
-        run = Run.from_dict(json.load(stream))
-    watch_parent = os.getppid()
     token = os.environ.get(TOKEN_VARIABLE)
     if not token:
         print(f"mbot_batch.run: {TOKEN_VARIABLE} is not set", file=sys.stderr)
         return 2
+    end_with_parent_or_signal(token)
+    with open(args.run_file) as stream:
+        run = Run.from_dict(json.load(stream))
     processes = RunProcesses(run, args.folder, args.gui, args.rviz)
-
-    def request_stop(signum, _frame):
-        processes.stop_reason = "stopped"
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
     try:
-        raw = processes.execute(started + run.timeout, watch_parent, token)
+        raw = processes.execute(started + run.timeout, token)
     except (RuntimeError, OSError) as error:
         raw = {"timeout": run.timeout, "timed_out": False, "error": f"the run could not start: {error}",
                "metrics": {}}
     finally:
         kill_token(token, exclude=(os.getpid(),))  # also when the start failed half-way
     raw["wall_seconds"] = time.monotonic() - started
-    if processes.stop_reason:
-        return 1  # stopped from outside: nothing to report
     with open(os.path.join(args.folder, "raw.json.tmp"), "w") as stream:
         json.dump(raw, stream)
     os.replace(os.path.join(args.folder, "raw.json.tmp"), os.path.join(args.folder, "raw.json"))
