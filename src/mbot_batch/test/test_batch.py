@@ -120,20 +120,26 @@ def cluster(tmp_path):
                                    "--scheduler-file", scheduler_file], stdout=logs[0], stderr=subprocess.STDOUT,
                                   start_new_session=True)]
     try:
-        wait_until(lambda: os.path.exists(scheduler_file), 60, "the scheduler's address")
+        wait_until(lambda: _address(scheduler_file), 60, "the scheduler's address")
         for index, log in enumerate(logs[1:], 1):
             processes.append(subprocess.Popen(
                 [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", scheduler_file,
                  "--nthreads", "1", "--name", f"worker-{index}", "--no-dashboard"],
                 stdout=log, stderr=subprocess.STDOUT, start_new_session=True))
-        with open(scheduler_file) as stream:
-            address = json.load(stream)["address"]
-        yield address, processes[1], processes[2]
+        yield _address(scheduler_file), processes[1], processes[2]
     finally:
         for process in processes:
             stop_group(process)
         for log in logs:
             log.close()
+
+
+def _address(scheduler_file):
+    try:
+        with open(scheduler_file) as stream:
+            return json.load(stream)["address"]
+    except (OSError, ValueError, KeyError):
+        return None  # not written yet, or half written
 
 
 def test_a_two_node_cluster_gives_the_embedded_results_and_reschedules_a_killed_workers_run(embedded, cluster,

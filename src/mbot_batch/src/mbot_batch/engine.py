@@ -88,7 +88,7 @@ def _collect_logs(folder: str) -> dict:
     paths = sorted(glob.glob(os.path.join(folder, "logs", "*")) + [os.path.join(folder, "run_process.log")]
                    + glob.glob(os.path.join(folder, "ros_home", "log", "**", "*.log"), recursive=True))
     for path in paths:
-        if os.path.isfile(path):
+        if os.path.isfile(path) and not os.path.islink(os.path.dirname(path)):  # not again through log/latest
             with open(path, "rb") as stream:
                 stream.seek(max(0, os.path.getsize(path) - LOG_CAP_BYTES))
                 name = os.path.relpath(path, folder).replace(os.sep, "__").removeprefix("logs__")
@@ -117,12 +117,13 @@ def connect(address, workers):
     return Client(cluster), cluster
 
 
-def run_batch(spec: Spec, out: str, address: str = None, workers: int = None, quiet: bool = False) -> int:
-    """Runs what is not finished in ``out`` yet; writes summary.csv and report.html. 0 when every run passed,
-    1 when some did not, 130 when interrupted."""
+def run_batch(spec: Spec, out: str, address: str = None, workers: int = None, quiet: bool = False,
+              runs=None) -> int:
+    """Runs what is not finished in ``out`` yet of ``runs`` (default: all the spec's); writes summary.csv and
+    report.html. 0 when every run passed, 1 when some did not, 130 when interrupted."""
     from distributed import as_completed
     from tqdm import tqdm
-    runs = spec.runs()
+    runs = runs or spec.runs()
     os.makedirs(out, exist_ok=True)
     shutil.copyfile(spec.path, os.path.join(out, "spec.yaml"))
     write_json(os.path.join(out, "batch.json"), {"spec": os.path.abspath(spec.path), "name": spec.name,

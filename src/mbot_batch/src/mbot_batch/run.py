@@ -99,11 +99,15 @@ class RunProcesses:
     def execute(self, deadline: float, token: str) -> dict:
         from mbot_sim_bridge.processes import PrivateMaster
         raw = {"timeout": self.run.timeout, "timed_out": False, "error": None, "exit_code": None, "metrics": {}}
-        with PrivateMaster(timeout=max(1.0, deadline - time.monotonic())) as master:
-            os.environ["ROS_MASTER_URI"] = master.uri
+        master = PrivateMaster(timeout=max(1.0, deadline - time.monotonic()))
+        os.environ["ROS_MASTER_URI"] = master.uri
+        # roslaunch's own start-up (seconds under load) overlaps the master's: it waits for the master. Not when
+        # the run sets parameters: those must be on the master before any node reads them.
+        launch = None if self.run.rostest_path or self.run.ros_params else self.start_launch()
+        with master:
             try:
                 self.set_parameters()
-                main_log, main, companions = self.start_run()
+                main_log, main, companions = self.start_run(launch or (self.run.launch_path and self.start_launch()))
                 ended = self.wait(main, companions, deadline)
             finally:
                 # The metrics are out: the run's processes are killed at once rather than stopped in turn, which
@@ -121,14 +125,16 @@ class RunProcesses:
             raw["rostest"] = self.rostest_counts()
         return raw
 
-    def start_run(self):
-        """The run's processes: rostest, or the launch file and the scenario (and rviz); (main log, main process,
-        companions whose end before the main one's is an error)."""
+    def start_launch(self):
+        return self.start(["roslaunch", "--wait", self.run.launch_path, *self.launch_arguments()], "launch.log")
+
+    def start_run(self, launch):
+        """The run's processes: rostest, or the launch file's (``launch``) scenario (and rviz); (main log, main
+        process, companions whose end before the main one's is an error)."""
         if self.run.rostest_path:
             main = self.start(["rostest", "--reuse-master", "--text", self.run.rostest_path,
                                *self.launch_arguments()], "rostest.log")
             return "rostest.log", main, []
-        launch = self.start(["roslaunch", self.run.launch_path, *self.launch_arguments()], "launch.log")
         environment = dict(os.environ, MBOT_BATCH_PARAMETERS=json.dumps(self.run.scenario_params))
         main = self.start([sys.executable, self.run.python_path], "scenario.log", environment)
         companions = [launch]
@@ -137,8 +143,12 @@ class RunProcesses:
         return "scenario.log", main, companions
 
     def set_parameters(self):
+        import uuid
+
         import rosgraph
         master = rosgraph.Master("/mbot_batch")
+        # As roscore sets it; roslaunch --wait waits for it.
+        master.setParam("/run_id", str(uuid.uuid1()))
         for name, value in self.run.ros_params.items():
             master.setParam(name, value)
 
