@@ -5,6 +5,7 @@
 - a real two-node cluster (``dask scheduler`` and two ``dask worker`` processes, each in its own process group),
   one worker killed while it runs a run: the run is rescheduled and every result equals the embedded one;
 - a hanging run killed at its timeout, retried, reported with its log tail;
+- a rostest scenario: its test cases' verdict and its metrics;
 - a failing run rerun with ``mbot batch rerun``: its metrics come out bit-identical;
 - the report page's figures in a headless Chromium screenshot.
 """
@@ -100,6 +101,7 @@ def test_a_killed_or_interrupted_driver_resumes_and_skips_finished_runs(embedded
     for stage in ("after kill", "after ctrl-c"):
         assert {run_id: final[run_id] for run_id in seen[stage]} == seen[stage], f"a run finished {stage} ran again"
     assert seen["ctrl-c exit"] == 130
+    print(f"figure: batch: Ctrl-C to the driver's exit {seen['ctrl-c seconds']:.1f} s, no run process left")
     assert seen["ctrl-c seconds"] < CTRL_C_SECONDS
     assert seen["left after ctrl-c"] == []
     with open(os.path.join(out, "summary.csv")) as summary:
@@ -166,6 +168,7 @@ def test_a_two_node_cluster_gives_the_embedded_results_and_reschedules_a_killed_
     assert driver.returncode == 1
     assert finished(out) == finished(reference)
     rescheduled = load_result(out, killed_run)
+    print(f"figure: batch: {killed_run}, its worker killed, finished on {rescheduled['worker']}")
     assert rescheduled["attempts"] == 1 and rescheduled["status"] == load_result(reference, killed_run)["status"]
     for run_id in finished(out):
         mine, theirs = load_result(out, run_id), load_result(reference, run_id)
@@ -205,6 +208,22 @@ def test_a_hanging_run_is_killed_at_its_timeout_retried_and_reported_with_its_lo
         assert "hanging on purpose" in junit.read()
     with open(os.path.join(out, "report.html")) as report:
         assert run_id in report.read()
+    assert_no_run_processes(out)
+
+
+def test_a_rostest_scenario_counts_its_test_cases_and_metrics(tmp_path):
+    spec = tmp_path / "rostest.yaml"
+    spec.write_text(f"scenarios:\n  drive:\n    rostest: {HERE}/scenarios/drive.test\n"
+                    "matrix:\n  speed: [0.0, 0.2]\ntimeout: 90\n")
+    out = str(tmp_path / "out")
+    driver = start_batch(out, "--workers", "2", spec=str(spec))
+    try:
+        driver.wait(timeout=BATCH_TIMEOUT)
+    finally:
+        stop_group(driver)
+    verdicts = sorted((result["metrics"]["x"] > 0.05, result["status"], result["reason"])
+                      for result in map(lambda run_id: load_result(out, run_id), finished(out)))
+    assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed"), (True, "passed", "")]
     assert_no_run_processes(out)
 
 

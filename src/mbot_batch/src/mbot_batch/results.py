@@ -38,33 +38,34 @@ def log_tail(text: str, lines: int = LOG_TAIL_LINES) -> str:
 
 
 def verdict(raw: dict, checks: Dict[str, Check]) -> dict:
-    """{status, reason, checks: [{metric, value, bounds, passed}]} of a run from its run process's ``raw`` record:
-    ``timed_out``, ``error`` (the run could not be run), ``exit_code``, ``metrics``, ``rostest`` ({tests, failed})."""
+    """{status, reason, completed, checks: [{metric, value, bounds, min, max, passed}]} of a run from its run
+    process's ``raw`` record: ``timed_out``, ``error`` (the run could not be run), ``exit_code``, ``metrics``,
+    ``rostest`` ({tests, failed}). ``completed``: the scenario ran to its end (and rostest's cases passed), so
+    that only the checks can have failed."""
     metrics = raw.get("metrics") or {}
     results = [{"metric": name, "value": metrics.get(name), "bounds": check.describe(), "min": check.minimum,
-                "max": check.maximum,
-                "passed": metrics.get(name) is not None and check.passes(metrics[name])}
+                "max": check.maximum, "passed": metrics.get(name) is not None and check.passes(metrics[name])}
                for name, check in checks.items()]
-    if raw.get("timed_out"):
-        return {"status": TIMEOUT, "reason": f"killed at its timeout of {raw['timeout']:g} s", "checks": results}
-    if raw.get("error"):
-        return {"status": ERROR, "reason": raw["error"], "checks": results}
-    bad = [name for name, value in metrics.items() if value is None]
-    if raw.get("exit_code") not in (0, None) and not raw.get("rostest"):
-        return {"status": ERROR, "reason": f"the scenario exited with status {raw['exit_code']}", "checks": results}
+
+    def outcome(status, reason, completed=False):
+        return {"status": status, "reason": reason, "completed": completed, "checks": results}
     rostest = raw.get("rostest")
+    if raw.get("timed_out"):
+        return outcome(TIMEOUT, f"killed at its timeout of {raw['timeout']:g} s")
+    if raw.get("error"):
+        return outcome(ERROR, raw["error"])
+    if raw.get("exit_code") not in (0, None) and not rostest:
+        return outcome(ERROR, f"the scenario exited with status {raw['exit_code']}")
     if rostest and (rostest["failed"] or not rostest["tests"]):
-        return {"status": FAILED, "reason": f"rostest: {rostest['failed']} of {rostest['tests']} test cases failed",
-                "checks": results}
+        return outcome(FAILED, f"rostest: {rostest['failed']} of {rostest['tests']} test cases failed")
+    bad = [name for name, value in metrics.items() if value is None]
     if bad:
-        return {"status": ERROR, "reason": f"metric '{bad[0]}' is not a number", "checks": results}
-    failing = [check for check in results if not check["passed"]]
+        return outcome(ERROR, f"metric '{bad[0]}' is not a number")
+    failing = [f"{check['metric']} = {'missing' if check['value'] is None else format(check['value'], 'g')}, "
+               f"wanted {check['bounds']}" for check in results if not check["passed"]]
     if failing:
-        first = failing[0]
-        shown = "missing" if first["value"] is None else f"{first['value']:g}"
-        return {"status": FAILED, "reason": f"{first['metric']} = {shown}, wanted {first['bounds']}",
-                "checks": results}
-    return {"status": PASSED, "reason": "", "checks": results}
+        return outcome(FAILED, "; ".join(failing), completed=True)
+    return outcome(PASSED, "", completed=True)
 
 
 def run_folder(out: str, run_id: str) -> str:
@@ -106,8 +107,7 @@ def junit(run: Run, result: dict) -> ElementTree.Element:
     for key, value in [("scenario", run.scenario), ("seed", run.seed), ("repetition", run.repetition),
                        *((f"matrix.{key}", json.dumps(value)) for key, value in run.values.items())]:
         ElementTree.SubElement(properties, "property", name=key, value=str(value))
-    cases = [("run", result["status"] in (PASSED, FAILED) and not result["reason"].startswith("rostest"),
-              result["reason"])]
+    cases = [("run", result["completed"], result["reason"])]
     cases += [(f"metric {check['metric']} {check['bounds']}", check["passed"],
                f"{check['metric']} = {check['value']}") for check in result["checks"]]
     failures = 0

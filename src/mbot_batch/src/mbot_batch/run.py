@@ -92,8 +92,6 @@ class RunProcesses:
         arguments = dict(self.run.launch_args, lockstep="true", seed=str(self.run.seed))
         if self.gui:
             arguments["gui"] = "true"
-        elif "gui" in _declared(self.run.launch_path or self.run.rostest_path):
-            arguments.setdefault("gui", "false")
         return [f"{name}:={value}" for name, value in arguments.items()]
 
     def execute(self, deadline: float, token: str) -> dict:
@@ -131,11 +129,11 @@ class RunProcesses:
     def start_run(self, launch):
         """The run's processes: rostest, or the launch file's (``launch``) scenario (and rviz); (main log, main
         process, companions whose end before the main one's is an error)."""
+        environment = dict(os.environ, MBOT_BATCH_PARAMETERS=json.dumps(self.run.scenario_params))
         if self.run.rostest_path:
             main = self.start(["rostest", "--reuse-master", "--text", self.run.rostest_path,
-                               *self.launch_arguments()], "rostest.log")
+                               *self.launch_arguments()], "rostest.log", environment)
             return "rostest.log", main, []
-        environment = dict(os.environ, MBOT_BATCH_PARAMETERS=json.dumps(self.run.scenario_params))
         main = self.start([sys.executable, self.run.python_path], "scenario.log", environment)
         companions = [launch]
         if self.rviz:
@@ -176,11 +174,6 @@ class RunProcesses:
             with open(path) as source, self.log("rostest-" + os.path.basename(path)) as copy:
                 copy.write(source.read())
         return {"tests": tests, "failed": failed}
-
-
-def _declared(path: str):
-    import roslaunch.arg_dump
-    return roslaunch.arg_dump.get_args([path])
 
 
 def _rviz_config() -> str:

@@ -125,7 +125,8 @@ class Spec:
         for key, value in values.items():
             targets.update(value if isinstance(value, dict) else {key: value})
         seed = int(targets.pop("seed", 0))
-        launch_args = dict(scenario.args)
+        # Headless unless the spec says otherwise (a rerun's --gui turns the window on).
+        launch_args = dict({"gui": "false"} if "gui" in scenario.declared_args else {}, **scenario.args)
         ros_params, scenario_params = {}, {}
         for target, value in targets.items():
             if target.startswith("args."):

@@ -75,7 +75,7 @@ def test_matrix_targets_reach_launch_arguments_ros_parameters_and_the_scenario(w
     text = GOOD.replace("  speed: [0.1, 0.2]", "  args.real_time_factor: [0]\n  params.mbot/gain: [1.5]\n"
                         "  start: [{args.x: 1.0, args.y: -2}]")
     run = load(write(text)).runs()[0]
-    assert run.launch_args == {"real_time_factor": "0", "x": "1.0", "y": "-2"}
+    assert run.launch_args == {"gui": "false", "real_time_factor": "0", "x": "1.0", "y": "-2"}
     assert run.ros_params == {"/mbot/gain": 1.5}
     assert run.labels["start"] == "#0"
 
