@@ -53,8 +53,8 @@ def execute_run(run_data: dict, token_prefix: str, options=()) -> dict:
         with open(run_file, "w") as stream:
             json.dump(run_data, stream)
         with open(os.path.join(folder, "run_process.log"), "w") as log:
-            process = subprocess.Popen([sys.executable, "-m", "mbot_batch.run", run_file, folder, *options],
-                                       env=dict(os.environ, **{TOKEN_VARIABLE: token}), stdout=log,
+            command = [sys.executable, "-m", "mbot_batch.run", run_file, folder, "--parent", str(os.getpid()), *options]
+            process = subprocess.Popen(command, env=dict(os.environ, **{TOKEN_VARIABLE: token}), stdout=log,
                                        stderr=subprocess.STDOUT, start_new_session=True)
         try:
             process.wait(timeout=run.timeout + RUN_PROCESS_MARGIN_SECONDS)

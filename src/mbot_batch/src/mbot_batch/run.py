@@ -9,15 +9,14 @@ the process that started this one dies (a worker killed), and at the end, every 
 killed at once. What it saw goes to FOLDER/raw.json; the logs to FOLDER/logs/.
 """
 import argparse
-import glob
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
 import threading
 import time
-from xml.etree import ElementTree
 
 from .results import parse_metrics
 from .spec import Run
@@ -119,7 +118,7 @@ class RunProcesses:
                 raw["exit_code"] = main.returncode
         with open(os.path.join(self.logs, main_log), errors="replace") as stream:
             raw["metrics"] = parse_metrics(stream.read())
-        if self.run.rostest_path:
+        if self.run.rostest_path and ended == "done":
             raw["rostest"] = self.rostest_counts()
         return raw
 
@@ -162,18 +161,15 @@ class RunProcesses:
             time.sleep(POLL_SECONDS)
 
     def rostest_counts(self) -> dict:
-        tests = failed = 0
-        for path in glob.glob(os.path.join(os.environ["ROS_HOME"], "test_results", "**", "*.xml"), recursive=True):
-            try:
-                root = ElementTree.parse(path).getroot()
-            except ElementTree.ParseError:
-                continue
-            for suite in ([root] if root.tag == "testsuite" else root.iter("testsuite")):
-                tests += int(suite.get("tests", 0))
-                failed += int(suite.get("failures", 0)) + int(suite.get("errors", 0))
-            with open(path) as source, self.log("rostest-" + os.path.basename(path)) as copy:
-                copy.write(source.read())
-        return {"tests": tests, "failed": failed}
+        """rostest's summary lines: in --text mode (which puts the test nodes' metric lines on its output) it
+        writes no XML results."""
+        with open(os.path.join(self.logs, "rostest.log"), errors="replace") as stream:
+            text = stream.read()
+        counts = {name: re.findall(rf"\* {name}: (\d+)", text) for name in ("TESTS", "ERRORS", "FAILURES")}
+        if not counts["TESTS"]:
+            return {"tests": 0, "failed": 0}
+        return {"tests": int(counts["TESTS"][-1]),
+                "failed": int(counts["ERRORS"][-1]) + int(counts["FAILURES"][-1])}
 
 
 def _rviz_config() -> str:
@@ -181,10 +177,11 @@ def _rviz_config() -> str:
     return os.path.join(rospkg.RosPack().get_path("mbot_description"), "config", "mbot_with_laser.rviz")
 
 
-def end_with_parent_or_signal(token: str):
-    """Kill the run and end this process at once on SIGINT/SIGTERM or when the process that started it dies (a
-    worker killed, a driver gone), whatever this process is doing: starting the master, waiting, stopping."""
-    parent = os.getppid()
+def end_with_parent_or_signal(token: str, parent: int):
+    """Kill the run and end this process at once on SIGINT/SIGTERM or when ``parent``, the process that started
+    it, dies (a worker killed, a driver gone), whatever this process is doing: starting the master, waiting,
+    stopping. The parent's pid comes from the parent: one that died while this process was still importing
+    would otherwise go unnoticed."""
 
     def end(*_):
         kill_token(token, exclude=(os.getpid(),))
@@ -205,13 +202,14 @@ def main(argv=None):
     parser.add_argument("folder")
     parser.add_argument("--gui", action="store_true")
     parser.add_argument("--rviz", action="store_true")
+    parser.add_argument("--parent", type=int, help="the starting process's pid (default: the parent now)")
     args = parser.parse_args(argv)
     started = time.monotonic()
     token = os.environ.get(TOKEN_VARIABLE)
     if not token:
         print(f"mbot_batch.run: {TOKEN_VARIABLE} is not set", file=sys.stderr)
         return 2
-    end_with_parent_or_signal(token)
+    end_with_parent_or_signal(token, args.parent or os.getppid())
     with open(args.run_file) as stream:
         run = Run.from_dict(json.load(stream))
     processes = RunProcesses(run, args.folder, args.gui, args.rviz)
