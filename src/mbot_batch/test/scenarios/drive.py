@@ -1,8 +1,6 @@
 #!/usr/bin/env python3
 """A short scenario for the batch tests: the mbot drives at the run's speed and turn rate for a second of sim
-time in lockstep, and reports where odometry puts it (``hang: true`` hangs instead)."""
-import time
-
+time in lockstep, and reports where odometry puts it."""
 import rospy
 from geometry_msgs.msg import Twist
 from mbot_batch import scenario
@@ -27,11 +25,6 @@ def drive(parameters: dict) -> dict:
 
 
 if __name__ == "__main__":
-    parameters = scenario.parameters()
-    if parameters.get("hang"):
-        print("hanging on purpose", flush=True)
-        while True:
-            time.sleep(1)
     rospy.init_node("drive_scenario", disable_signals=True)
-    for name, value in drive(parameters).items():
+    for name, value in drive(scenario.parameters()).items():
         scenario.metric(name, value)
