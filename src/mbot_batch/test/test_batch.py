@@ -42,6 +42,15 @@ def start_batch(out, *options, spec=SPEC):
                                 preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
+def batch_to_its_end(out, spec, workers):
+    """The batch's exit status."""
+    driver = start_batch(out, "--workers", str(workers), spec=spec)
+    try:
+        return driver.wait(timeout=BATCH_TIMEOUT)
+    finally:
+        stop_group(driver)
+
+
 def finished(out):
     folder = os.path.join(out, "runs")
     return {run_id for run_id in (os.listdir(folder) if os.path.isdir(folder) else ())
@@ -194,12 +203,7 @@ def test_a_hanging_run_is_killed_at_its_timeout_retried_and_reported_with_its_lo
                     "matrix:\n  seed: [0]\ntimeout: 8\nretries: 1\n")
     shutil.copy(os.path.join(HERE, "scenarios", "hang.py"), tmp_path)
     out = str(tmp_path / "out")
-    driver = start_batch(out, "--workers", "1", spec=str(spec))
-    try:
-        driver.wait(timeout=BATCH_TIMEOUT)
-    finally:
-        stop_group(driver)
-    assert driver.returncode == 1
+    assert batch_to_its_end(out, str(spec), workers=1) == 1
     (run_id,) = finished(out)
     result = load_result(out, run_id)
     assert result["status"] == "timeout" and result["attempts"] == 2, result
@@ -218,11 +222,7 @@ def test_a_rostest_scenario_counts_its_test_cases_and_metrics(tmp_path):
     spec.write_text(f"scenarios:\n  drive:\n    rostest: {HERE}/scenarios/drive.test\n"
                     "matrix:\n  speed: [0.0, 0.2]\ntimeout: 90\n")
     out = str(tmp_path / "out")
-    driver = start_batch(out, "--workers", "2", spec=str(spec))
-    try:
-        driver.wait(timeout=BATCH_TIMEOUT)
-    finally:
-        stop_group(driver)
+    batch_to_its_end(out, str(spec), workers=2)
     verdicts = sorted((result["metrics"]["x"] > 0.05, result["status"], result["reason"])
                       for result in map(lambda run_id: load_result(out, run_id), finished(out)))
     assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed"), (True, "passed", "")]

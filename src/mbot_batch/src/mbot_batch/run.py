@@ -1,4 +1,4 @@
-"""One run, in a process of its own: ``python3 -m mbot_batch.run RUN.json FOLDER [--gui] [--rviz]``.
+"""One run, in a process of its own: ``python3 -m mbot_batch.run RUN.json FOLDER [--parent PID] [--gui] [--rviz]``.
 
 It starts a private ROS master on a free port, sets the run's ROS parameters, then either the launch file (in
 lockstep, with the run's seed) and the Python scenario that drives it, or ``rostest`` against that master. Every
