@@ -12,6 +12,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -177,11 +178,11 @@ def _rviz_config() -> str:
     return os.path.join(rospkg.RosPack().get_path("mbot_description"), "config", "mbot_with_laser.rviz")
 
 
-def end_with_parent_or_signal(token: str, parent: int):
+def end_with_parent_or_signal(token: str, parent: int, folder: str):
     """Kill the run and end this process at once on SIGINT/SIGTERM or when ``parent``, the process that started
     it, dies (a worker killed, a driver gone), whatever this process is doing: starting the master, waiting,
     stopping. The parent's pid comes from the parent: one that died while this process was still importing
-    would otherwise go unnoticed."""
+    would otherwise go unnoticed. Without its parent, nobody will read the run's folder: it goes too."""
 
     def end(*_):
         kill_token(token, exclude=(os.getpid(),))
@@ -190,7 +191,9 @@ def end_with_parent_or_signal(token: str, parent: int):
     def watch():
         while os.getppid() == parent:
             time.sleep(POLL_SECONDS)
-        end()
+        kill_token(token, exclude=(os.getpid(),))
+        shutil.rmtree(folder, ignore_errors=True)
+        os._exit(1)
     signal.signal(signal.SIGINT, end)
     signal.signal(signal.SIGTERM, end)
     threading.Thread(target=watch, name="parent watch", daemon=True).start()
@@ -209,7 +212,7 @@ def main(argv=None):
     if not token:
         print(f"mbot_batch.run: {TOKEN_VARIABLE} is not set", file=sys.stderr)
         return 2
-    end_with_parent_or_signal(token, args.parent or os.getppid())
+    end_with_parent_or_signal(token, args.parent or os.getppid(), args.folder)
     with open(args.run_file) as stream:
         run = Run.from_dict(json.load(stream))
     processes = RunProcesses(run, args.folder, args.gui, args.rviz)
