@@ -54,17 +54,19 @@ def _yaw(orientation) -> float:
 
 
 class Recorder:
-    """The robot's path from /odom and the lidar's hits from /scan, in the odom frame."""
+    """The robot's path from /odom and the lidar's hits from /scan, in the odom frame (without ``scan_points``,
+    the path only: no TF listener deserializing every /tf in this process)."""
 
-    def __init__(self, sim: LockstepClient):
+    def __init__(self, sim: LockstepClient, scan_points: bool = True):
         self.arrived = threading.Condition()
         self.stamps, self.path, self.headings, self.scan_points = [], [], [], []
         self.scans = 0
-        self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(120))
-        self.tf_listener = tf2_ros.TransformListener(self.tf_buffer)
         # Connected both ways before the first step, so no message of the tour is missed.
-        self.subscribers = [sim.subscriber("/odom", Odometry, self._on_odometry),
-                            sim.subscriber("/scan", LaserScan, self._on_scan)]
+        self.subscribers = [sim.subscriber("/odom", Odometry, self._on_odometry)]
+        if scan_points:
+            self.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(120))
+            self.tf_listener = tf2_ros.TransformListener(self.tf_buffer)
+            self.subscribers.append(sim.subscriber("/scan", LaserScan, self._on_scan))
 
     def _on_odometry(self, message):
         with self.arrived:
@@ -120,8 +122,10 @@ class Tour:
     simulation stopped at, so every run reads the same odometry and sends the same commands, however fast the
     machine and its messages are."""
 
-    def __init__(self, sim: LockstepClient, recorder: Recorder, step_size: float, on_terminal: bool):
+    def __init__(self, sim: LockstepClient, recorder: Recorder, step_size: float, on_terminal: bool,
+                 segment_sim_timeout: float = SEGMENT_SIM_TIMEOUT):
         self.sim = sim
+        self.segment_sim_timeout = segment_sim_timeout
         self.recorder = recorder
         self.control_steps = max(1, round(CONTROL_PERIOD / step_size))
         self.control_period = self.control_steps * step_size
@@ -156,7 +160,7 @@ class Tour:
         start = self.pose[0]
         wall_deadline = time.monotonic() + WALL_TIMEOUT
         while not done(self.pose):
-            if self.pose[0] - start > SEGMENT_SIM_TIMEOUT or time.monotonic() > wall_deadline:
+            if self.pose[0] - start > self.segment_sim_timeout or time.monotonic() > wall_deadline:
                 raise RuntimeError(f"the robot did not finish '{what}' (stuck at x {self.pose[1]:.2f}, "
                                    f"y {self.pose[2]:.2f})")
             self.progress()

@@ -1,0 +1,254 @@
+"""./mbot batch end to end, on 12 short runs (the mbot drives for a second of sim time in the empty world):
+
+- the embedded default: the driver killed (SIGKILL) after two runs, then Ctrl-C'd, then run to the end, each
+  time resuming and skipping finished runs; no process of a run is left after a kill or a Ctrl-C;
+- a real two-node cluster (``dask scheduler`` and two ``dask worker`` processes, each in its own process group),
+  one worker killed while it runs a run: the run is rescheduled and every result equals the embedded one;
+- a hanging run killed at its timeout, retried, reported with its log tail;
+- a rostest scenario: its test cases' verdict and its metrics;
+- a failing run rerun with ``mbot batch rerun``: its metrics come out bit-identical;
+- the report page's figures in a headless Chromium screenshot.
+"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+from mbot_batch.engine import batch_token
+from mbot_batch.results import load_result
+from mbot_batch.run import processes_with_token
+from ros_processes import wait_until
+
+pytestmark = pytest.mark.long
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+BATCH = os.path.join(HERE, os.pardir, "scripts", "mbot_batch")
+SPEC = os.path.join(HERE, "scenarios", "drive.yaml")
+RUNS = 12
+BATCH_TIMEOUT = 240
+CTRL_C_SECONDS = 5.0
+
+
+def start_batch(out, *options, spec=SPEC):
+    log = open(os.path.join(os.path.dirname(out), f"driver-{time.monotonic_ns()}.log"), "w")
+    with log:
+        # SIGINT as in a terminal's foreground: a runner started as a background job passes it on ignored.
+        return subprocess.Popen([sys.executable, BATCH, spec, "-o", out, "--quiet", *options], stdout=log,
+                                stderr=subprocess.STDOUT, start_new_session=True,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
+
+def batch_to_its_end(out, spec, workers):
+    """The batch's exit status."""
+    driver = start_batch(out, "--workers", str(workers), spec=spec)
+    try:
+        return driver.wait(timeout=BATCH_TIMEOUT)
+    finally:
+        stop_group(driver)
+
+
+def finished(out):
+    folder = os.path.join(out, "runs")
+    return {run_id for run_id in (os.listdir(folder) if os.path.isdir(folder) else ())
+            if os.path.exists(os.path.join(folder, run_id, "result.json"))}
+
+
+def result_files(out):
+    return {run_id: os.stat(os.path.join(out, "runs", run_id, "result.json")).st_mtime_ns for run_id in finished(out)}
+
+
+def assert_no_run_processes(out, timeout=3.0):
+    wait_until(lambda: not processes_with_token(batch_token(out)), timeout, f"the runs of {out} to be gone")
+
+
+def stop_group(process):
+    try:
+        os.killpg(process.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    process.wait()
+
+
+@pytest.fixture(scope="module")
+def embedded(tmp_path_factory):
+    """The 12 runs on the embedded default, interrupted twice on the way; what each interruption left."""
+    out = str(tmp_path_factory.mktemp("embedded") / "out")
+    seen = {}
+    driver = start_batch(out, "--workers", "2")
+    try:
+        wait_until(lambda: len(finished(out)) >= 2, BATCH_TIMEOUT, "two finished runs")
+        driver.send_signal(signal.SIGKILL)  # the driver alone, as the kernel's OOM killer would
+        driver.wait()
+        assert_no_run_processes(out, timeout=10.0)  # each run process sees its worker die and kills its run
+        seen["after kill"] = result_files(out)
+
+        driver = start_batch(out, "--workers", "2")
+        wait_until(lambda: processes_with_token(batch_token(out)), 60, "a resumed run to be running")
+        interrupted = time.monotonic()
+        os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the driver and its workers
+        seen["ctrl-c exit"] = driver.wait(timeout=30)
+        seen["ctrl-c seconds"] = time.monotonic() - interrupted
+        seen["left after ctrl-c"] = processes_with_token(batch_token(out))
+        seen["after ctrl-c"] = result_files(out)
+
+        driver = start_batch(out, "--workers", "2")
+        driver.wait(timeout=BATCH_TIMEOUT)
+        seen["exit"] = driver.returncode
+    finally:
+        stop_group(driver)
+    return out, seen
+
+
+def test_a_killed_or_interrupted_driver_resumes_and_skips_finished_runs(embedded):
+    out, seen = embedded
+    assert seen["exit"] == 1  # the runs at speed 0 fail their check
+    assert len(finished(out)) == RUNS
+    final = result_files(out)
+    for stage in ("after kill", "after ctrl-c"):
+        assert {run_id: final[run_id] for run_id in seen[stage]} == seen[stage], f"a run finished {stage} ran again"
+    assert seen["ctrl-c exit"] == 130
+    print(f"figure: batch: Ctrl-C to the driver's exit {seen['ctrl-c seconds']:.1f} s, no run process left")
+    assert seen["ctrl-c seconds"] < CTRL_C_SECONDS
+    assert seen["left after ctrl-c"] == []
+    with open(os.path.join(out, "summary.csv")) as summary:
+        assert len(summary.read().splitlines()) == RUNS + 1
+    for run_id in finished(out):
+        assert {"junit.xml", "metrics.json", "run.json", "logs"} <= set(os.listdir(os.path.join(out, "runs", run_id)))
+    assert_no_run_processes(out)
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    """A scheduler and two single-threaded workers, each in a process group of its own, as Dask's docs start a
+    cluster by hand (``dask scheduler``, ``dask worker ADDRESS``)."""
+    scheduler_file = str(tmp_path / "scheduler.json")
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    logs = [open(tmp_path / f"{name}.log", "w") for name in ("scheduler", "worker-1", "worker-2")]
+    processes = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                   "--scheduler-file", scheduler_file], stdout=logs[0], stderr=subprocess.STDOUT,
+                                  start_new_session=True)]
+    try:
+        wait_until(lambda: _address(scheduler_file), 60, "the scheduler's address")
+        for index, log in enumerate(logs[1:], 1):
+            processes.append(subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", scheduler_file,
+                 "--nthreads", "1", "--name", f"worker-{index}", "--no-dashboard"],
+                stdout=log, stderr=subprocess.STDOUT, start_new_session=True))
+        yield _address(scheduler_file), processes[1], processes[2]
+    finally:
+        for process in processes:
+            stop_group(process)
+        for log in logs:
+            log.close()
+
+
+def _address(scheduler_file):
+    try:
+        with open(scheduler_file) as stream:
+            return json.load(stream)["address"]
+    except (OSError, ValueError, KeyError):
+        return None  # not written yet, or half written
+
+
+def test_a_two_node_cluster_gives_the_embedded_results_and_reschedules_a_killed_workers_run(embedded, cluster,
+                                                                                           tmp_path):
+    reference, _ = embedded
+    address, doomed, survivor = cluster
+    out = str(tmp_path / "out")
+    driver = start_batch(out, "--address", address)
+    try:
+        def doomed_run():
+            for pid in processes_with_token(batch_token(out)):
+                try:
+                    if os.getpgid(_parent(pid)) == doomed.pid:
+                        return _token(pid).split(":")[1]
+                except (OSError, ValueError):
+                    continue
+            return None
+        wait_until(doomed_run, BATCH_TIMEOUT, "a run on the first worker")
+        killed_run = doomed_run()
+        os.killpg(doomed.pid, signal.SIGKILL)  # the whole node: its nanny and worker process
+        driver.wait(timeout=BATCH_TIMEOUT)
+    finally:
+        stop_group(driver)
+    assert driver.returncode == 1
+    assert finished(out) == finished(reference)
+    rescheduled = load_result(out, killed_run)
+    print(f"figure: batch: {killed_run}, its worker killed, finished on {rescheduled['worker']}")
+    assert rescheduled["attempts"] == 1 and rescheduled["status"] == load_result(reference, killed_run)["status"]
+    for run_id in finished(out):
+        mine, theirs = load_result(out, run_id), load_result(reference, run_id)
+        assert (mine["status"], mine["metrics"]) == (theirs["status"], theirs["metrics"]), run_id
+    assert_no_run_processes(out, timeout=10.0)
+
+
+def _parent(pid):
+    with open(f"/proc/{pid}/stat") as stream:
+        return int(stream.read().rsplit(")", 1)[1].split()[1])
+
+
+def _token(pid):
+    with open(f"/proc/{pid}/environ", "rb") as stream:
+        return next(v for v in stream.read().split(b"\0") if v.startswith(b"MBOT_BATCH_RUN=")).decode().split("=")[1]
+
+
+def test_a_hanging_run_is_killed_at_its_timeout_retried_and_reported_with_its_log_tail(tmp_path):
+    spec = tmp_path / "hang.yaml"
+    spec.write_text("scenarios:\n  hang:\n    launch: mbot_gazebo mbot_world.launch\n    python: hang.py\n"
+                    "matrix:\n  seed: [0]\ntimeout: 8\nretries: 1\n")
+    shutil.copy(os.path.join(HERE, "scenarios", "hang.py"), tmp_path)
+    out = str(tmp_path / "out")
+    assert batch_to_its_end(out, str(spec), workers=1) == 1
+    (run_id,) = finished(out)
+    result = load_result(out, run_id)
+    assert result["status"] == "timeout" and result["attempts"] == 2, result
+    assert 8.0 <= result["wall_seconds"] < 8.0 + 5.0
+    assert "hanging on purpose" in result["log_tail"]
+    assert sorted(os.listdir(os.path.join(out, "runs", run_id, "logs"))) == ["attempt-1", "attempt-2"]
+    with open(os.path.join(out, "runs", run_id, "junit.xml")) as junit:
+        assert "hanging on purpose" in junit.read()
+    with open(os.path.join(out, "report.html")) as report:
+        assert run_id in report.read()
+    assert_no_run_processes(out)
+
+
+def test_a_rostest_scenario_counts_its_test_cases_and_metrics(tmp_path):
+    spec = tmp_path / "rostest.yaml"
+    spec.write_text(f"scenarios:\n  drive:\n    rostest: {HERE}/scenarios/drive.test\n"
+                    "matrix:\n  speed: [0.0, 0.2]\ntimeout: 90\n")
+    out = str(tmp_path / "out")
+    batch_to_its_end(out, str(spec), workers=2)
+    verdicts = sorted((result["metrics"]["x"] > 0.05, result["status"], result["reason"])
+                      for result in map(lambda run_id: load_result(out, run_id), finished(out)))
+    assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed"), (True, "passed", "")]
+    assert_no_run_processes(out)
+
+
+def test_rerunning_a_failing_run_reproduces_its_metrics_bit_identically(embedded):
+    out, _ = embedded
+    failing = sorted(run_id for run_id in finished(out) if load_result(out, run_id)["status"] == "failed")
+    assert failing
+    rerun = subprocess.run([sys.executable, BATCH, "rerun", out, failing[0]], capture_output=True, text=True,
+                           timeout=120)
+    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
+    assert "status: failed" in rerun.stdout and "metrics bit-identical to the batch's" in rerun.stdout
+    assert os.path.exists(os.path.join(out, "reruns", failing[0], "scenario.log"))
+
+
+def test_the_report_shows_its_figures_in_a_browser(embedded, tmp_path):
+    out, _ = embedded
+    screenshot = tmp_path / "report.png"
+    subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", f"--user-data-dir={tmp_path}/chrome",
+                    f"--screenshot={screenshot}", "--window-size=1200,2400", f"file://{out}/report.html"],
+                   capture_output=True, timeout=120, check=True)
+    import numpy
+    from PIL import Image
+    pixels = numpy.asarray(Image.open(screenshot).convert("RGB")).reshape(-1, 3)
+    # The bars of the pass-rate figure (green: all passed, orange: some failed) and the metric histograms (blue).
+    for name, colour in (("passed bars", (0x44, 0xaa, 0x44)), ("failing bars", (0xcc, 0x88, 0x44)),
+                         ("histogram bars", (0x44, 0x88, 0xcc))):
+        assert (numpy.abs(pixels.astype(int) - colour).sum(axis=1) < 30).sum() > 500, f"no {name} in the screenshot"
