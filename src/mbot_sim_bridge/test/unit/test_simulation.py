@@ -3,10 +3,12 @@ plugins' core classes and no ROS master; per-sensor random streams; plugin failu
 import logging
 import math
 import os
+import sys
 
 import numpy as np
 import pytest
 
+from mbot_sim_bridge.core.clock import UpdateTimer
 from mbot_sim_bridge.core.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
@@ -120,6 +122,47 @@ def test_a_failing_plugin_is_disabled_and_the_rest_runs(mbot_urdf, caplog):
         assert sim.sim_time == pytest.approx(0.2)
     finally:
         sim.close()
+
+
+def test_a_plugin_whose_timer_overflows_is_disabled_and_the_rest_runs(mbot_urdf, caplog):
+    """A timer that raises (here a period of 1e308 s counted in steps, as a rate of 1e-308 Hz gave) is its
+    plugin's failure, contained like one, in stepping and in reset."""
+    sim = simulation()
+    try:
+        spawned = sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot")
+        drive = plugin_of(spawned, DiffDrive)
+
+        def overflow(*_):
+            return math.floor(math.inf)
+        drive.timer.steps_until_due = overflow
+        with caplog.at_level(logging.ERROR):
+            sim.step(100)
+        assert drive not in spawned.plugins
+        assert caplog.text.count("GazeboRosDiffDrive(ns = /) failed and is disabled: OverflowError") == 1
+        joint_states = plugin_of(spawned, JointStatePublisher)
+        joint_states.timer.due = overflow
+        sim.reset(simulation=False)
+        sim.step(100)
+        assert spawned.plugins == [] and sim.sim_time == pytest.approx(0.2)
+    finally:
+        sim.close()
+
+
+def test_a_rate_or_period_too_small_to_count_is_refused_and_never_overflows(mbot_urdf):
+    """1e-308 Hz is a period of 1e308 s: refused at the door, and a timer given it anyway is never due."""
+    sim = simulation()
+    try:
+        urdf = mbot_urdf.replace("<updateRate>100.0</updateRate>", "<updateRate>1e-308</updateRate>", 1)
+        assert urdf != mbot_urdf
+        with pytest.raises(ConfigError, match=r"model 'mbot':\d+: GazeboRosDiffDrive\(ns = /\): <updateRate> has bad "
+                                              r"value '1e-308': 1e-308 is outside the valid range <= 0 or >= 1e-06$"):
+            sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot")
+        assert sim.model_names() == ["ground_plane"]
+    finally:
+        sim.close()
+    for rate in (1e-308, 5e-324):
+        timer = UpdateTimer(rate)
+        assert timer.steps_until_due(1.0, 0.001) == sys.maxsize and not timer.due(1e9)
 
 
 def test_a_bad_tag_refuses_the_spawn_and_leaves_nothing(mbot_urdf):

@@ -36,7 +36,7 @@ from .image_formats import (FORMAT_ENCODINGS, add_image_noise, convert_image, de
                             image_encoding, point_cloud)
 from .geometry import IDENTITY, Pose, compose
 from .log import get_logger, info_once, warn_once
-from .params import Param, PluginParams, non_negative, positive
+from .params import Param, PluginParams, non_negative, positive, rate
 from .plugin import Plugin
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
 from .render_scene import CameraRenderer
@@ -47,9 +47,9 @@ _log = get_logger(__name__)
 # The rate a sensor with <update_rate> 0 and plugin updateRate 0 renders at (Gazebo: as fast as it can).
 DEFAULT_FRAME_RATE = 30.0
 CAMERA_SENSOR_PARAMS = (
-    non_negative("update_rate", float, 0.0, "frames per sim second; 0 = the plugin's updateRate, else 30",
-                 warn_if_missing=False),
-    Param("camera/horizontal_fov", float, 1.047, "rad", minimum=0, exclusive_minimum=True, maximum=3.1416,
+    rate("update_rate", 0.0, "frames per sim second; 0 = the plugin's updateRate, else 30",
+         warn_if_missing=False),
+    Param("camera/horizontal_fov", float, 1.047, "rad (SDF's minimum 0.1)", minimum=0.1, maximum=3.1416,
           warn_if_missing=False),
     Param("camera/image/width", int, 320, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
     Param("camera/image/height", int, 240, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
@@ -71,8 +71,8 @@ CAMERA_PARAMS = (
     Param("imageTopicName", str, "image_raw", "sensor_msgs/Image", warn_if_missing=False),
     Param("cameraInfoTopicName", str, "camera_info", "sensor_msgs/CameraInfo", warn_if_missing=False),
     Param("frameName", str, "", "frame_id of every message", warn_if_missing=False),
-    non_negative("updateRate", float, 0.0, "Hz throttle on top of the sensor update_rate; 0 = every frame",
-                 warn_if_missing=False),
+    rate("updateRate", 0.0, "Hz throttle on top of the sensor update_rate; 0 = every frame",
+         warn_if_missing=False),
     Param("hackBaseline", float, 0.0, "P[3] = -f * hackBaseline", warn_if_missing=False),
     non_negative("focalLength", float, 0.0, "0 = width / (2 tan(hfov/2))", warn_if_missing=False),
     Param("Cx", float, 0.0, "0 = (width + 1) / 2", warn_if_missing=False),

@@ -21,7 +21,7 @@ from typing import NamedTuple, Optional, Tuple
 from . import names
 from .hector_imu import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from .params import Param, non_negative
+from .params import Param, rate
 from .plugin import Plugin
 
 EQUATORIAL_RADIUS = 6378137.0
@@ -67,7 +67,7 @@ class HectorGps(HectorUpdates, Plugin):
         Param("service", int, 0, "NavSatStatus service bits", warn_if_missing=False, minimum=0, maximum=65535),
         Param("useWorldSphericalCoordinates", bool, False, "true: not emulated, the reference tags apply",
               warn_if_missing=False),
-        non_negative("updateRate", float, 4.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 4.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("", 3, "position (m)"),
         *sensor_model_params("velocity", 3, "velocity (m/s)"),

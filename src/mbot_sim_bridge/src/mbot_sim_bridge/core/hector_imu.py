@@ -28,7 +28,7 @@ from .geometry import IDENTITY, Pose, compose, inverse, pose_from_xyz_rpy, rotat
 from .hector_sensor_model import SensorModel, sensor_model_params
 from .imu import gazebo_body, read_vector_param
 from .log import get_logger, warn_once
-from .params import ERROR_MODEL_LIMIT, Param, non_negative
+from .params import ERROR_MODEL_LIMIT, Param, non_negative, period, rate
 from .plugin import Plugin
 
 _logger = get_logger(__name__)
@@ -37,8 +37,8 @@ Quaternion = Tuple[float, float, float, float]
 Vector = Tuple[float, float, float]
 
 HECTOR_UPDATE_PARAMS = (
-    non_negative("updatePeriod", float, 0.0, "s between updates; overrides updateRate when given",
-                 warn_if_missing=False),
+    period("updatePeriod", 0.0, "s between updates; overrides updateRate when given",
+           warn_if_missing=False),
 )
 
 
@@ -132,7 +132,7 @@ class HectorImu(HectorUpdates, Plugin):
                      warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, no effect (as upstream)", warn_if_missing=False),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation", warn_if_missing=False),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("accel", 3, "acceleration (m/s²)"),
         *sensor_model_params("rate", 3, "angular rate (rad/s)"),

@@ -35,7 +35,7 @@ from .clock import UpdateTimer
 from .errors import ConfigError
 from .geometry import IDENTITY, Pose, compose, rotation_matrix
 from .log import get_logger, info_once
-from .params import Param, PluginParams, non_negative, positive
+from .params import Param, PluginParams, non_negative, positive, rate
 from .plugin import Plugin
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
 from .xml_values import XmlDocument
@@ -44,7 +44,7 @@ _log = get_logger(__name__)
 
 # The <sensor> values of a ray sensor (SDF names and defaults; Gazebo does not warn about missing SDF tags).
 RAY_SENSOR_PARAMS = (
-    non_negative("update_rate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+    rate("update_rate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
     Param("ray/scan/horizontal/samples", int, None, "rays per sweep", required=True, minimum=1),
     positive("ray/scan/horizontal/resolution", float, 1.0, "ranges per ray (interpolated)", warn_if_missing=False),
     Param("ray/scan/horizontal/min_angle", float, None, "first ray (rad)", required=True),

@@ -16,7 +16,7 @@ from . import names
 from .clock import UpdateTimer
 from .diff_drive import yaw_rotated_velocity
 from .geometry import Pose, yaw
-from .params import Param
+from .params import Param, rate
 from .plugin import Plugin
 
 
@@ -36,7 +36,7 @@ class PlanarMove(Plugin):
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry (ground truth)"),
         Param("odometryFrame", str, "odom", "frame_id of the odometry and parent of the TF"),
         Param("robotBaseFrame", str, "base_footprint", "child frame of the odometry and the TF"),
-        Param("odometryRate", float, 20.0, "Hz of sim time; <= 0 = no odometry"),
+        rate("odometryRate", 20.0, "Hz of sim time; <= 0 = no odometry", signed=True),
         Param("cmdTimeout", float, -1.0, "s without a command before it is zeroed; < 0 = never"),
     )
     needs_every_step = True

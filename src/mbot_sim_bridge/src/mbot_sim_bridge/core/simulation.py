@@ -8,6 +8,7 @@ ROS layer's registry derived from it, so the core never imports the ROS plugin l
 """
 import hashlib
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
@@ -313,7 +314,9 @@ class Simulation:
         wrench_steps = self.wrenches.steps_until_next(now, step)
         if wrench_steps is not None:
             batch = min(batch, wrench_steps)
-        return min([batch] + [plugin.timer.steps_until_due(now, step) for plugin in self._plugins])
+        # A timer is part of its plugin: one that raises (an overflowing period) disables the plugin, not the loop.
+        return min([batch] + [self._guarded(plugin, plugin.timer.steps_until_due, now, step) or sys.maxsize
+                              for plugin in self._plugins])
 
     def advance(self, max_steps: int, before_updates: Optional[BeforeUpdates] = None) -> int:
         """Step up to the next plugin event or ``max_steps``, then run the due updates; returns the steps taken."""
@@ -328,7 +331,7 @@ class Simulation:
         if broken:
             self._freeze(broken)
         now = self.sim_time
-        due = [plugin for plugin in self._plugins if plugin.timer.due(now)]
+        due = [plugin for plugin in self._plugins if self._guarded(plugin, plugin.timer.due, now)]
         if before_updates is not None:
             before_updates(now, bool(due))
         for plugin in due:
@@ -376,11 +379,11 @@ class Simulation:
                     self._disable(plugin, error)
         return on_step
 
-    def _guarded(self, plugin: Plugin, method, argument):
-        """``method(argument)``; a plugin that raises is disabled (None is returned), and the simulation and
+    def _guarded(self, plugin: Plugin, method, *arguments):
+        """``method(*arguments)``; a plugin that raises is disabled (None is returned), and the simulation and
         other models go on."""
         try:
-            return method(argument)
+            return method(*arguments)
         except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
             self._disable(plugin, error)
 

@@ -13,7 +13,7 @@ from . import names
 from .clock import UpdateTimer
 from .diff_drive import TwistCommand, yaw_rotated_velocity
 from .geometry import Pose, yaw
-from .params import Param, non_negative, positive
+from .params import Param, non_negative, positive, rate
 from .plugin import Plugin
 
 WHEEL_TAGS = ("leftFrontJoint", "rightFrontJoint", "leftRearJoint", "rightRearJoint")
@@ -43,7 +43,7 @@ class SkidSteerDrive(TwistCommand, Plugin):
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry (ground truth)"),
         Param("odometryFrame", str, "odom", "frame_id of the odometry"),
         Param("robotBaseFrame", str, "base_footprint", "child_frame_id of the odometry"),
-        Param("updateRate", float, 100.0, "Hz of sim time; <= 0 = every physics step"),
+        rate("updateRate", 100.0, "Hz of sim time; <= 0 = every physics step", signed=True),
         non_negative("covariance_x", float, 0.0001, "pose and twist covariance of x"),
         non_negative("covariance_y", float, 0.0001, "pose and twist covariance of y"),
         non_negative("covariance_yaw", float, 0.01, "pose and twist covariance of yaw"),

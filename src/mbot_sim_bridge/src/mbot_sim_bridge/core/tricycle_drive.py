@@ -24,7 +24,7 @@ from . import names
 from .clock import UpdateTimer
 from .diff_drive import TwistCommand, yaw_rotated_velocity
 from .geometry import Pose, pose_from_xyz_rpy, yaw
-from .params import Param, non_negative, positive
+from .params import Param, non_negative, positive, rate
 from .plugin import Plugin
 from .ros_control.hardware_interface import UNBOUNDED_EFFORT
 
@@ -58,7 +58,7 @@ class TricycleDrive(TwistCommand, Plugin):
         Param("odometryFrame", str, "odom", "frame_id of the odometry and parent of the TF"),
         Param("robotBaseFrame", str, "base_link", "child frame of the odometry and the TF"),
         Param("odometrySource", str, "world", "world (ground truth) or encoder", choices=ODOMETRY_SOURCES),
-        Param("updateRate", float, 100.0, "Hz of sim time; <= 0 = every physics step"),
+        rate("updateRate", 100.0, "Hz of sim time; <= 0 = every physics step", signed=True),
         non_negative("wheelAcceleration", float, 0.0, "rad/s² when slowing; 0 = no limit"),
         non_negative("wheelDeceleration", float, None, "rad/s² when speeding up; absent: wheelAcceleration",
                      warn_if_missing=False),
