@@ -10,7 +10,7 @@ import pytest
 
 from mbot_sim_bridge.core.clock import UpdateTimer
 from mbot_sim_bridge.core.diff_drive import DiffDrive
-from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.errors import ConfigError, ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.lidar import RaySensor
@@ -163,6 +163,33 @@ def test_a_rate_or_period_too_small_to_count_is_refused_and_never_overflows(mbot
     for rate in (1e-308, 5e-324):
         timer = UpdateTimer(rate)
         assert timer.steps_until_due(1.0, 0.001) == sys.maxsize and not timer.due(1e9)
+
+
+def revolute_chain(joints: int) -> str:
+    links = ['<link name="l0"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+             'iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>']
+    for index in range(1, joints + 1):
+        links.append(f'<link name="l{index}"><inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" '
+                     f'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+                     f'<joint name="j{index}" type="revolute"><parent link="l{index - 1}"/><child link="l{index}"/>'
+                     f'<origin xyz="0 0 0.01"/><axis xyz="0 0 1"/>'
+                     f'<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>')
+    return f'<robot name="chain">{chr(10).join(links)}</robot>'
+
+
+@pytest.mark.parametrize("joints", [128, 1000])
+def test_more_movable_joints_than_a_pybullet_body_holds_are_refused_and_leave_nothing(joints):
+    sim = simulation()
+    try:
+        with pytest.raises(ModelError, match=rf"^SpawnModel: model 'chain': {joints} movable joints; a PyBullet body "
+                                             r"holds at most 127 \(128 links with the base\); nothing was spawned$"):
+            sim.spawn_robot(parse_robot(revolute_chain(joints), "model 'chain'"), "chain")
+        assert sim.model_names() == ["ground_plane"] and sim.engine.client.getNumBodies() == 1
+        sim.spawn_robot(parse_robot(revolute_chain(127), "model 'chain'"), "chain")
+        sim.step(10)
+        assert sim.engine.robots_not_finite() == []
+    finally:
+        sim.close()
 
 
 def test_a_bad_tag_refuses_the_spawn_and_leaves_nothing(mbot_urdf):

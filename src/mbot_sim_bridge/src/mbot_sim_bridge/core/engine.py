@@ -32,6 +32,9 @@ MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
 # Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
 DEFAULT_MU = 1.0
+# PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
+# every query fails ("GetBasePositionAndOrientation failed").
+MAX_BODY_LINKS = 128
 
 
 class CachingBulletClient(BulletClient):
@@ -331,6 +334,10 @@ class Engine:
         if name in self.robots or name in self.world_bodies:
             raise ModelError(f"model '{name}' already exists")
         check_state(f"SpawnModel: model '{name}'", pose)
+        body_links = len({holder for holder, _ in model.lumped_into.values()})
+        if body_links > MAX_BODY_LINKS:
+            raise ModelError(f"SpawnModel: model '{name}': {body_links - 1} movable joints; a PyBullet body holds at "
+                             f"most {MAX_BODY_LINKS - 1} ({MAX_BODY_LINKS} links with the base); nothing was spawned")
         robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace, pose)
         self._place(robot, driven_joints)
         return robot
