@@ -187,7 +187,7 @@ def test_more_movable_joints_than_a_pybullet_body_holds_are_refused_and_leave_no
         assert sim.model_names() == ["ground_plane"] and sim.engine.client.getNumBodies() == 1
         sim.spawn_robot(parse_robot(revolute_chain(127), "model 'chain'"), "chain")
         sim.step(10)
-        assert sim.engine.robots_not_finite() == []
+        assert sim.engine.models_not_finite() == []
     finally:
         sim.close()
 

@@ -261,6 +261,7 @@ class Engine:
         self.steps = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
+        self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
         # PyBullet body -> link index -> Gazebo's "model::link::collision" of the collision it holds.
         self.collision_names: Dict[int, Dict[int, str]] = {}
         self._initial: Dict[int, _InitialState] = {}
@@ -287,6 +288,7 @@ class Engine:
         self.steps = 0
         self.robots.clear()
         self.world_bodies.clear()
+        self.dynamic_world_bodies.clear()
         self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
@@ -314,6 +316,8 @@ class Engine:
         """Register the bodies a world loader built, so reset and model queries know them."""
         for name, body in world.bodies.items():
             self.world_bodies[name] = body
+            if self.client.getDynamicsInfo(body, -1)[0] > 0.0:
+                self.dynamic_world_bodies[name] = body
             shapes = [shape for shape in world.shapes if shape.model == name]
             # One static collision is the body's base; otherwise each collision is a child link, in order.
             links = [-1] if self.client.getNumJoints(body) == 0 else range(len(shapes))
@@ -366,6 +370,7 @@ class Engine:
             body = self.robots.pop(name).body
         elif name in self.world_bodies:
             body = self.world_bodies.pop(name)
+            self.dynamic_world_bodies.pop(name, None)
         else:
             raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
@@ -410,13 +415,14 @@ class Engine:
         for body in self._initial:
             self._restore_initial_state(body)
 
-    def robots_not_finite(self) -> List[str]:
-        """The robots whose base pose the last steps made NaN or infinite. Run after every step, so kept to one
-        state query and one sum per robot (a NaN or inf anywhere makes the sum so)."""
+    def models_not_finite(self) -> List[str]:
+        """The robots and moving world models whose base pose the last steps made NaN or infinite. Run after every
+        batch of steps, so kept to one state query and one sum per body (a NaN or inf anywhere makes the sum so)."""
         state, finite = self.client.getBasePositionAndOrientation, math.isfinite
+        bodies = chain(((name, robot.body) for name, robot in self.robots.items()), self.dynamic_world_bodies.items())
         broken = []
-        for name, robot in self.robots.items():
-            position, orientation = state(robot.body)
+        for name, body in bodies:
+            position, orientation = state(body)
             if not finite(sum(position) + sum(orientation)):
                 broken.append(name)
         return broken

@@ -46,6 +46,8 @@ _SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)
 # kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
 _MAX_MASS = 1e9
 _MAX_INERTIA = 1e9
+# A joint axis shorter than this is taken for none (normalising it would lose all precision).
+_MIN_AXIS_LENGTH = 1e-6
 
 
 @dataclass
@@ -250,11 +252,16 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         other = next((j.name for j in joints.values() if j.child == child.get("link")), None)
         if other is not None:
             raise ModelError(f"{where}: child link '{child.get('link')}' already has a parent joint, '{other}'")
-        axis = element.find("axis")
+        axis_element = element.find("axis")
+        axis = (read_attribute_numbers(axis_element, "xyz", document, (0.0, 0.0, 0.0))
+                if axis_element is not None else (1.0, 0.0, 0.0))
+        # ODE refuses to normalise a zero axis (dNormalize3); Bullet divides by it and the robot turns NaN.
+        if joint_type in MOVABLE_JOINT_TYPES and not math.hypot(*axis) >= _MIN_AXIS_LENGTH:
+            raise ModelError(f"{document.where(axis_element)}: joint '{joint_name}': "
+                             f"<axis xyz=\"{axis_element.get('xyz')}\"> has no direction; "
+                             f"a {joint_type} joint needs an axis of length at least {_MIN_AXIS_LENGTH:g}")
         joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
-                                   read_origin(element, document),
-                                   read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
-                                   if axis is not None else (1.0, 0.0, 0.0),
+                                   read_origin(element, document), axis,
                                    safety=_safety_controller(element, where, document),
                                    mimic=_mimic(element, where, document),
                                    **_joint_limits(element, joint_type, document))

@@ -84,7 +84,7 @@ class Simulation:
         self._plugins: List[Plugin] = []
         self._every_step_calls: List[Callable[[], None]] = []  # on_step of the plugins that need every step
         self._recording: List[Plugin] = []
-        self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
+        self._frozen: Set[str] = set()  # models the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
         self.add_world(world)
@@ -327,7 +327,7 @@ class Simulation:
         per_step = [recorder for recorder in recorders if recorder is not None]
         per_step += self._every_step_calls
         self.engine.step(count, per_step)
-        broken = self.engine.robots_not_finite()
+        broken = self.engine.models_not_finite()
         if broken:
             self._freeze(broken)
         now = self.sim_time
@@ -341,10 +341,16 @@ class Simulation:
         return count
 
     def _freeze(self, names: Sequence[str]):
-        """Robots whose state the physics made NaN go back to their spawn state with their plugins stopped until
-        a reset. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
+        """Models whose state the physics made NaN go back to their spawn state (a robot with its plugins stopped)
+        until a reset; one that turns NaN again by itself is deleted, so the recovery is not repeated every
+        step. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
         through the ground, and even a static ground plane reads NaN), so the world is rebuilt with every other
         moving model's state carried over."""
+        for name in [name for name in names if name in self._frozen]:
+            self.delete(name)
+            _logger.error(f"model '{name}': the physics made its state NaN again after it was put back at its spawn "
+                          "pose, with nothing driving it; it is deleted")
+        names = [name for name in names if name in self.model_names()]
         moving = [name for name in self.engine.model_names() if name not in names and not (
             name in self.world_models and self.world_models[name].static)]
         kept = {name: state for name, state in self.engine.body_states(moving).items() if state.finite}
@@ -358,7 +364,7 @@ class Simulation:
         self.version += 1
         for name in names:
             _logger.error(f"model '{name}': the physics step made its state NaN; it is put back at its spawn pose "
-                          "and frozen (its plugins stopped) until reset_world or reset_simulation")
+                          "and frozen (a robot's plugins stopped) until reset_world or reset_simulation")
 
     def step(self, count: int, before_updates: Optional[BeforeUpdates] = None):
         """Exactly ``count`` physics steps, with every plugin event on the way."""
