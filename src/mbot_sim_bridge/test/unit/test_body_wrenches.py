@@ -61,6 +61,22 @@ def test_a_crate_held_by_its_weight_hovers_until_the_wrench_ends_or_is_cleared(t
     sim.close()
 
 
+@pytest.mark.parametrize("simulation", [False, True])
+def test_a_reset_ends_every_wrench_so_the_world_is_as_spawned(tmp_path, simulation):
+    """Resets repair what service calls left (the README): a wrench "until cleared" ends with them too."""
+    sim = world_simulation(tmp_path, CRATE)
+    try:
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (0, 0, 3 * CRATE_MASS * GRAVITY), (0, 0, 0), 0.0, -1.0)
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (0, 0, 0), (0, 0, 1), 5.0, 1.0)
+        sim.step(200)
+        sim.reset(simulation)
+        assert not sim.wrenches.pending()
+        sim.step(1000)
+        assert crate_height(sim) == pytest.approx(0.15, abs=1e-3)  # fell onto the ground and rests there
+    finally:
+        sim.close()
+
+
 def test_f3d_reports_the_applied_force_and_nothing_without_one(tmp_path):
     sim = world_simulation(tmp_path)
     spawned = sim.spawn_robot(parse_robot(ARM.format(body="plate"), "model 'arm'"), "arm")

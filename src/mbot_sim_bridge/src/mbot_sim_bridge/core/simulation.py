@@ -416,6 +416,7 @@ class Simulation:
         else:
             self.engine.reset_world()
         self._frozen.clear()
+        self.wrenches = BodyWrenches()  # resets repair what service calls left: wrenches "until cleared" too
         self._schedule()
         self.version += 1
         for plugin in list(self._plugins):
