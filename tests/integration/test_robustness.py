@@ -7,6 +7,7 @@ and it still takes requests.
 import math
 import os
 import subprocess
+import threading
 import time
 from xml.etree import ElementTree
 
@@ -329,3 +330,83 @@ def test_set_model_state_with_an_overflowing_quaternion(env, bridge):
                                             "{w: 1.5e+154}}}}")
     assert response["success"] or "\n" not in response["status_message"], response
     assert all(math.isfinite(v) for v in model_pose(env, "good"))
+
+
+# -- issue 39: calls during long work, a description too big to read in the loop, more joints than PyBullet holds ---
+def test_calls_during_a_long_step_are_carried_out_and_answered_at_once(env, bridge, monkeypatch):
+    """The loop serves other calls between the batches of a step_simulation: each is carried out and answered
+    while the step goes on (before, they failed after 30 s with an empty text and ran afterwards); a second
+    step_simulation is refused at once with the reason."""
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])  # call_service sets it per call, in two threads
+    call(env, "pause_physics")
+    try:
+        started = time.monotonic()
+        assert call(env, "step_simulation", "{steps: 2000}")["success"]
+        steps = int(2000 * 20 / (time.monotonic() - started))  # about 20 s of the loop
+        answer = {}
+        stepper = threading.Thread(target=lambda: answer.update(
+            call_service(env, "/gazebo/step_simulation", f"{{steps: {steps}}}", 300)), daemon=True)
+        before = sim_time(env)
+        stepper.start()
+        wait_until(lambda: sim_time(env) > before, 10, "the step to start")
+        second = call(env, "step_simulation", "{steps: 1}")
+        assert not second["success"] and "another step_simulation is under way" in second["status_message"], second
+        box = ("<sdf version='1.6'><model name='box'><static>true</static><pose>5 5 0.5 0 0 0</pose><link name='l'>"
+               "<collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link></model>"
+               "</sdf>")
+        assert call(env, "spawn_sdf_model", f'{{model_name: box, model_xml: "{box}"}}')["success"]
+        assert "box" in model_names(env) and all(math.isfinite(v) for v in model_pose(env, "good"))
+        assert call(env, "delete_model", "{model_name: box}")["success"]
+        assert stepper.is_alive(), "the step ended before the calls were made; make it longer"
+        stepper.join(300)
+        assert answer["success"] and answer["sim_time"] >= before + steps * 0.001 - 1e-6, answer
+    finally:
+        call(env, "unpause_physics")
+    assert_still_serving(env, bridge)
+
+
+def test_a_50_mb_description_does_not_stop_the_clock(env, bridge, mbot_urdf, monkeypatch):
+    """A description of 700,000 <gazebo reference> blocks (100,000 unless MBOT_FULL_SWEEP=1: the suite's time) is
+    read in the service's thread, so /clock goes on while it loads (before, it stopped for 25 s and then
+    jumped)."""
+    import rospy
+    from gazebo_msgs.srv import SpawnModel, SpawnModelRequest
+
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
+    block = '<gazebo reference="base_link"><material>Gazebo/Blue</material></gazebo>'
+    blocks = 720000 if os.environ.get("MBOT_FULL_SWEEP") else 100000
+    request = SpawnModelRequest(model_name="big", model_xml=mbot_urdf.replace("</robot>", block * blocks + "</robot>"))
+    request.initial_pose.position.x = -3.0
+    answer = []
+    spawner = threading.Thread(target=lambda: answer.append(
+        rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)(request)), daemon=True)
+    spawner.start()
+    longest, last, times = 0.0, time.monotonic(), [sim_time(env)]
+    while spawner.is_alive():
+        times.append(sim_time(env))
+        now = time.monotonic()
+        if times[-1] > times[-2]:
+            longest, last = max(longest, now - last), now
+        time.sleep(0.2)
+    spawner.join()
+    assert answer and answer[0].success, answer
+    print(f"figure: /clock while a {len(request.model_xml) / 1e6:.0f} MB description loaded: longest stall "
+          f"{longest:.1f} s")
+    assert longest < 2.0  # 3.3 s at 100,000 blocks before, 0.5 s after (1.1 s at 720,000)
+    assert call(env, "delete_model", "{model_name: big}")["success"]
+    assert_still_serving(env, bridge)
+
+
+def test_more_joints_than_a_pybullet_body_holds_are_refused_and_the_bridge_carries_on(env, bridge, tmp_path):
+    links = ['<link name="l0"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
+             'ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+             '</link>']
+    for index in range(1, 1001):
+        links.append(f'<link name="l{index}"><inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" '
+                     f'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j{index}" '
+                     f'type="revolute"><parent link="l{index - 1}"/><child link="l{index}"/><axis xyz="0 0 1"/>'
+                     f'<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>')
+    result = spawn(env, tmp_path, "chain", '<robot name="chain">' + "\n".join(links) + "</robot>")
+    assert_refused(result, "chain", "1000 movable joints; a PyBullet body holds at most 127")
+    assert "chain" not in model_names(env)
+    assert_still_serving(env, bridge)
