@@ -197,6 +197,25 @@ def test_set_model_state_refuses_nan_and_reset_repairs(env, bridge):
         assert_still_serving(env, bridge, drive=True)
 
 
+@pytest.mark.parametrize("field, expected", [
+    ("pose: {position: {x: 1.0e+300}}", "position.x = 1e+300 is outside ±100000"),  # said "position.x is inf"
+    ("twist: {angular: {z: 1.0e+300}}", "angular velocity.z = 1e+300 is outside ±10000"),  # said "velocity.x is nan"
+])
+def test_set_model_state_names_the_value_sent(env, bridge, field, expected):
+    response = call(env, "set_model_state", f"{{model_state: {{model_name: good, {field}}}}}")
+    assert response["success"] is False and expected in response["status_message"], response
+
+
+def test_a_quaternion_of_huge_components_is_normalised(env, bridge):
+    """Four components of 1e308 normalise to (0.5, 0.5, 0.5, 0.5), as gazebo_ros normalises (refused as NaN before)."""
+    spawn_z = model_pose(env, "good")[2]
+    response = call(env, "set_model_state", "{model_state: {model_name: good, pose: {position: {z: 1}, orientation: "
+                                            "{x: 1.0e+308, y: 1.0e+308, z: 1.0e+308, w: 1.0e+308}}}}")
+    assert response["success"] is True, response
+    call(env, "reset_world")
+    wait_until(lambda: abs(model_pose(env, "good")[2] - spawn_z) < 0.05, 30, "reset_world to put the mbot back")
+
+
 # -- 5: a missing mesh names the file, the link and the model ---------------------------------------------------
 def _with_mesh(urdf, kind, filename):
     root = ElementTree.fromstring(urdf)

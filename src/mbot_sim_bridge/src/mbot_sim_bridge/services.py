@@ -43,9 +43,12 @@ MAX_STEP_SIM_SECONDS = 3600.0
 def _pose_from_message(message: PoseMessage) -> Pose:
     """The pose with its quaternion normalised, as gazebo_ros does; a zero quaternion is the identity."""
     q = message.orientation
-    norm = math.hypot(q.x, q.y, q.z, q.w)  # hypot, not a sum of squares: no overflow for huge components
+    # Scaled by the largest component first: four components of 1e308 normalise, and hypot does not overflow.
+    largest = max(abs(q.x), abs(q.y), abs(q.z), abs(q.w))
+    scaled = (q.x, q.y, q.z, q.w) if largest in (0.0, math.inf) else tuple(v / largest for v in (q.x, q.y, q.z, q.w))
+    norm = math.hypot(*scaled)
     # A non-finite component stays non-finite here, and check_state refuses it by name.
-    orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else (q.x / norm, q.y / norm, q.z / norm, q.w / norm)
+    orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else tuple(v / norm for v in scaled)
     return Pose((message.position.x, message.position.y, message.position.z), orientation)
 
 
@@ -106,7 +109,10 @@ class GazeboRosApi:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
         if request.model_name in self.sim.model_names():
             raise ModelError(f"SpawnModel: Failure - entity already exists: {request.model_name}")
-        pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+        requested = _pose_from_message(request.initial_pose)
+        # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
+        check_state(f"SpawnModel: model '{request.model_name}'", requested)
+        pose = compose(self._reference_pose(request.reference_frame), requested)
         check_state(f"SpawnModel: model '{request.model_name}'", pose)
         return pose
 
@@ -201,10 +207,13 @@ class GazeboRosApi:
 
         def set_state():
             reference = self._reference_pose(state.reference_frame)
-            pose = compose(reference, _pose_from_message(state.pose))
-            twist = state.twist
-            linear = rotate(reference.orientation, (twist.linear.x, twist.linear.y, twist.linear.z))
-            angular = rotate(reference.orientation, (twist.angular.x, twist.angular.y, twist.angular.z))
+            requested, twist = _pose_from_message(state.pose), state.twist
+            linear, angular = ((twist.linear.x, twist.linear.y, twist.linear.z),
+                               (twist.angular.x, twist.angular.y, twist.angular.z))
+            # Checked as sent too: transformed, 1e300 would turn inf and NaN, and on other axes.
+            check_state(f"SetModelState: model '{state.model_name}'", requested, linear, angular)
+            pose = compose(reference, requested)
+            linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
             self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
