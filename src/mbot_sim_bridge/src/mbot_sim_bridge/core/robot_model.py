@@ -260,17 +260,31 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
             raise ModelError(f"{document.where(axis_element)}: joint '{joint_name}': "
                              f"<axis xyz=\"{axis_element.get('xyz')}\"> has no direction; "
                              f"a {joint_type} joint needs an axis of length at least {_MIN_AXIS_LENGTH:g}")
-        joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
-                                   read_origin(element, document), axis,
-                                   safety=_safety_controller(element, where, document),
-                                   mimic=_mimic(element, where, document),
-                                   **_joint_limits(element, joint_type, document))
+        limit = element.find("limit")
+        if limit is None and joint_type in ("revolute", "prismatic"):
+            # urdfdom's own rule; PyBullet said only "Cannot load URDF file", naming the robot.
+            raise ModelError(f"{document.where(element)}: joint '{joint_name}' is of type {joint_type} but it does not "
+                             f"specify limits (<limit lower upper effort velocity>)")
+        joints[joint_name] = joint = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
+                                           read_origin(element, document), axis,
+                                           safety=_safety_controller(element, where, document),
+                                           mimic=_mimic(element, where, document),
+                                           **_joint_limits(element, joint_type, document))
+        if joint.lower > joint.upper:
+            raise ModelError(f"{document.where(limit)}: joint '{joint_name}': <limit lower=\"{joint.lower:g}\"> is "
+                             f"above upper=\"{joint.upper:g}\"")
 
     for joint in joints.values():
         if joint.mimic is not None and (joint.mimic[0] not in joints or not joints[joint.mimic[0]].movable
                                         or not joint.movable):
             raise ModelError(f"{source} joint '{joint.name}': <mimic joint='{joint.mimic[0]}'> needs a movable joint "
                              f"mimicking a movable joint of the robot")
+        followed = [joint.name]
+        while joints[followed[-1]].mimic is not None:
+            followed.append(joints[followed[-1]].mimic[0])
+            if followed[-1] in followed[:-1]:
+                raise ModelError(f"{source} joint '{joint.name}': <mimic> joints follow each other in a circle: "
+                                 f"{' -> '.join(followed)}; one of them must follow a joint that is driven")
     children = {joint.child for joint in joints.values()}
     roots = [link_name for link_name in links if link_name not in children]
     if len(roots) != 1:
