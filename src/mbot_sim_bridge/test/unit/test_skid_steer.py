@@ -2,6 +2,7 @@
 lines within 5 %, turns the commanded way, ground-truth odometry, bad joints refused, NaN ignored, reset."""
 import math
 import os
+import re
 
 import pytest
 import xacro_noetic as xacro
@@ -63,3 +64,16 @@ def test_a_wheel_joint_the_robot_lacks_is_refused(tmp_path):
         sim.spawn_robot(parse_robot(urdf().replace('name="rear_left_wheel_joint"', 'name="rear_left_hinge"'),
                                     "model 'skid'"), "skid")
     sim.close()
+
+
+def test_wheels_mapped_to_one_joint_are_refused(tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        text = urdf()
+        for tag in ("rightFrontJoint", "leftRearJoint", "rightRearJoint"):
+            text = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>front_left_wheel_joint</{tag}>", text)
+        with pytest.raises(ConfigError, match="<leftFrontJoint> and <rightFrontJoint> both name joint "
+                                              "'front_left_wheel_joint'"):
+            sim.spawn_robot(parse_robot(text, "model 'skid'"), "skid")
+    finally:
+        sim.close()
