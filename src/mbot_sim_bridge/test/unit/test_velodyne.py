@@ -2,12 +2,14 @@
 in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
 import math
 import os
+import re
 
 import numpy as np
 import pytest
 import xacro_noetic as xacro
 from sensor_fixtures import box, plugin_of, world_simulation
 
+from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
 from mbot_sim_bridge.core.robot_model import parse_robot
 from mbot_sim_bridge.core.velodyne_laser import VelodyneLaser
@@ -38,6 +40,28 @@ def velodyne(tmp_path, noise=0.0, organize=False):
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand", Pose((0.0, 0.0, 0.0), (0, 0, 0, 1)))
     sim.step(10)
     return sim, plugin_of(spawned, VelodyneLaser)
+
+
+@pytest.mark.parametrize("tags, message", [
+    ({"min_range": "10", "max_range": "1"}, r"readings are kept between <min_range> 10 .* and <max_range> 1 .*: "
+                                            r"none would be$"),
+    ({"max_range": "0"}, r"<max_range> has bad value '0': 0 is outside the valid range > 0$"),
+])
+def test_a_range_window_that_keeps_nothing_is_refused(tmp_path, tags, message):
+    path = tmp_path / "stand.urdf.xacro"
+    path.write_text(STAND.format(macro=os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro")),
+                                 noise=0.0, organize="false"))
+    urdf = xacro.process_file(str(path)).toxml()
+    for tag, text in tags.items():
+        urdf, replaced = re.subn(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", urdf)
+        assert replaced == 1
+    sim = world_simulation(tmp_path)
+    try:
+        with pytest.raises(ConfigError, match=message):
+            sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand")
+        assert "stand" not in sim.model_names()
+    finally:
+        sim.close()
 
 
 def test_sixteen_rings_lowest_first_and_points_on_the_wall(tmp_path):

@@ -15,6 +15,7 @@ from typing import NamedTuple, Optional, Tuple
 from . import names
 from .clock import UpdateTimer
 from .diff_drive import yaw_rotated_velocity
+from .engine import MAX_SPEED
 from .geometry import Pose, yaw
 from .params import Param, rate
 from .plugin import Plugin
@@ -56,8 +57,9 @@ class PlanarMove(Plugin):
         self.latest: Optional[PlanarOdometry] = None
 
     def set_command(self, x: float, y: float, rotation: float) -> bool:
-        """Store a body twist; a non-finite one is refused (False) and the last valid one stays."""
-        if not all(math.isfinite(value) for value in (x, y, rotation)):
+        """Store a body twist; one that is not finite or beyond MAX_SPEED (set_model_state's cap: 1e10 m/s sent
+        the base 50 m backwards in one step) is refused (False) and the last valid one stays."""
+        if not all(abs(value) <= MAX_SPEED for value in (x, y, rotation)):  # False for NaN too
             return False
         with self._lock:
             self._command = (x, y, rotation)

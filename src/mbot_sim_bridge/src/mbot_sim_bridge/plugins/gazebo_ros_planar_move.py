@@ -3,6 +3,7 @@ import rospy
 from geometry_msgs.msg import Twist
 
 from ..core.diff_drive import ODOM_POSE_COVARIANCE
+from ..core.engine import MAX_SPEED
 from ..core.names import resolve_frame, tf_prefix
 from ..core.planar_move import PlanarMove
 from ..subscriptions import TrackedSubscriber
@@ -29,8 +30,9 @@ class GazeboRosPlanarMove(RosPlugin, PlanarMove):
     def _on_command(self, message: Twist):
         x, y, rotation = message.linear.x, message.linear.y, message.angular.z
         if not self.set_command(x, y, rotation):
-            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a non-finite value "
-                                        f"(linear {x}, {y}, angular.z {rotation}); keeping the last valid command")
+            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a value that is not "
+                                        f"finite or beyond {MAX_SPEED:g} (linear {x}, {y}, angular.z {rotation}); "
+                                        "keeping the last valid command")
 
     def update(self, now: float):
         super().update(now)
