@@ -90,12 +90,13 @@ class HectorGps(HectorUpdates, Plugin):
         self.latest: Optional[GpsReading] = None
 
     def geodetic(self, position) -> Tuple[float, float, float]:
-        """(latitude, longitude, altitude) of a world position, as upstream converts it."""
+        """(latitude, longitude, altitude) of a world position, as upstream converts it, with the longitude
+        wrapped into [-180, 180) as a receiver reports it (near a pole upstream's reached millions of degrees)."""
         x, y, z = position
         cos_h, sin_h = math.cos(self.heading), math.sin(self.heading)
+        longitude = self.params["referenceLongitude"] - math.degrees((-sin_h * x + cos_h * y) / self.radius_east)
         return (self.params["referenceLatitude"] + math.degrees((cos_h * x + sin_h * y) / self.radius_north),
-                self.params["referenceLongitude"] - math.degrees((-sin_h * x + cos_h * y) / self.radius_east),
-                self.params["referenceAltitude"] + z)
+                (longitude + 180.0) % 360.0 - 180.0, self.params["referenceAltitude"] + z)
 
     def update(self, now: float):
         dt = self.elapsed(now)
