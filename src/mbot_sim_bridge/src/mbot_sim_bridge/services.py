@@ -19,7 +19,7 @@ from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
-from .core.engine import check_state
+from .core.engine import check_model_name, check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .gazebo_paths import model_path
@@ -109,6 +109,7 @@ class GazeboRosApi:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
         if request.model_name in self.sim.model_names():
             raise ModelError(f"SpawnModel: Failure - entity already exists: {request.model_name}")
+        check_model_name("SpawnModel", request.model_name)
         requested = _pose_from_message(request.initial_pose)
         # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
         check_state(f"SpawnModel: model '{request.model_name}'", requested)

@@ -3,6 +3,7 @@ plugins' core classes and no ROS master; per-sensor random streams; plugin failu
 import logging
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -188,6 +189,18 @@ def test_more_movable_joints_than_a_pybullet_body_holds_are_refused_and_leave_no
         sim.spawn_robot(parse_robot(revolute_chain(127), "model 'chain'"), "chain")
         sim.step(10)
         assert sim.engine.models_not_finite() == []
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("name", ["", "a::b", "/", "a b"])
+def test_a_name_gazebo_could_not_address_is_refused(mbot_urdf, name):
+    sim = simulation()
+    try:
+        with pytest.raises(ModelError, match=rf"^SpawnModel: model name {re.escape(repr(name))}: a model name must be "
+                                             r"non-empty, without whitespace, '::' .* or '/'; nothing was spawned$"):
+            sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), name)
+        assert sim.model_names() == ["ground_plane"]
     finally:
         sim.close()
 

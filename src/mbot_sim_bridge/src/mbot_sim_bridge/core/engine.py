@@ -107,6 +107,14 @@ def check_state(what: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0
                          f"nothing was changed")
 
 
+def check_model_name(what: str, name: str):
+    """ModelError for a name Gazebo could not address: empty, with whitespace, Gazebo's scope separator "::"
+    ("model::link" names a link) or "/"."""
+    if not name or "::" in name or "/" in name or any(character.isspace() for character in name):
+        raise ModelError(f"{what}: model name {name!r}: a model name must be non-empty, without whitespace, '::' "
+                         f"(which separates a model's links) or '/'; nothing was spawned")
+
+
 def _friction(text: str, model: str, link: str) -> float:
     try:
         value = parse_float(text)
@@ -337,6 +345,7 @@ class Engine:
         """
         if name in self.robots or name in self.world_bodies:
             raise ModelError(f"model '{name}' already exists")
+        check_model_name("SpawnModel", name)
         check_state(f"SpawnModel: model '{name}'", pose)
         body_links = len({holder for holder, _ in model.lumped_into.values()})
         if body_links > MAX_BODY_LINKS:
