@@ -13,6 +13,7 @@ that frame's orientation relative to the link, and the torque gains (frame posit
 force. The result is applied in the world frame, so a wrench given in the link's own frame acts along the world
 axes (upstream's "FIXME map is really wrong").
 """
+import sys
 import threading
 from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple
 
@@ -79,7 +80,10 @@ class BodyWrenches:
             starts = [job.start for job in self._jobs]
         if not starts:
             return None
-        return max(1, int(np.ceil((min(starts) - now) / step_size - 1e-9)))
+        steps = (min(starts) - now) / step_size - 1e-9
+        if not steps < sys.maxsize:  # a start too far off to count in steps (1e308 s overflowed): not due
+            return sys.maxsize
+        return max(1, int(np.ceil(steps)))
 
     def due(self, now: float) -> Dict[Tuple[str, str], Tuple[Vector, Vector]]:
         """(model, link) -> (force, torque) to apply in the step starting at ``now``; ended jobs are dropped."""

@@ -180,8 +180,9 @@ class SpawnedRobot:
 
     def joint_rows(self, indices: Sequence[int]):
         """PyBullet's getJointStates rows (position, velocity, reaction wrench, applied effort) of joints by
-        ``joint_index``: joint_state without its name lookups and copies, for readers after every step."""
-        return self.client.getJointStates(self.body, indices)
+        ``joint_index``: joint_state without its name lookups and copies, for readers after every step. PyBullet
+        answers None for no joints."""
+        return self.client.getJointStates(self.body, indices) or ()
 
     def link_world_velocity(self, link_name: str):
         """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
