@@ -164,6 +164,7 @@ def assert_refused(result, name, *expected):
     ({"wheelTorque": "-30"}, ("<wheelTorque>", "'-30'", ">= 0")),
     ({"wheelAcceleration": "-1.8"}, ("<wheelAcceleration>", "'-1.8'", ">= 0")),
     ({"wheelDiameter": "1e-300"}, ("<wheelDiameter>", "'1e-300'", ">= 0.001")),
+    ({"updateRate": "1e-308"}, ("<updateRate>", "'1e-308'", "<= 0 or >= 1e-06")),  # issue 39: the node died
 ])
 def test_bad_wheel_tags_refuse_the_spawn(env, bridge, tmp_path, mbot_urdf, tags, expected):
     result = spawn(env, tmp_path, "bad", with_drive_tags(mbot_urdf, **tags))
@@ -413,6 +414,21 @@ def test_a_50_mb_description_does_not_stop_the_clock(env, bridge, mbot_urdf, mon
           f"{longest:.1f} s")
     assert longest < 2.0  # 3.3 s at 100,000 blocks before, 0.5 s after (1.1 s at 720,000)
     assert call(env, "delete_model", "{model_name: big}")["success"]
+    assert_still_serving(env, bridge)
+
+
+@pytest.mark.parametrize("inertial, expected", [
+    ("<mass>1e300</mass>", "<mass>: 1e+300 is outside the valid range >= 1e-06 and <= 1e+09"),
+    ("<mass>1</mass><inertia><ixx>0</ixx><iyy>1</iyy><izz>1</izz></inertia>", "<inertia> has principal moments 0"),
+])
+def test_sdf_inertials_that_turned_the_model_nan_are_refused(env, bridge, tmp_path, inertial, expected):
+    """A mass of 1e300 was accepted, and the model's pose read NaN until it was deleted."""
+    sdf = NAN_POSE_SDF.replace("nan 0 1", "0 3 1").replace("<link name='l'>", f"<link name='l'><inertial>{inertial}"
+                                                                           "</inertial>")
+    assert "<inertial>" in sdf
+    result = spawn(env, tmp_path, "heavy", sdf, kind="-sdf")
+    assert_refused(result, "heavy", "link 'l' of model 'heavy'", expected)
+    assert "heavy" not in model_names(env)
     assert_still_serving(env, bridge)
 
 

@@ -77,3 +77,15 @@ def test_wheels_mapped_to_one_joint_are_refused(tmp_path):
             sim.spawn_robot(parse_robot(text, "model 'skid'"), "skid")
     finally:
         sim.close()
+
+
+@pytest.mark.parametrize("tag", ["wheelDiameter", "wheelSeparation"])
+def test_a_wheel_size_below_a_millimetre_is_refused(tmp_path, tag):
+    """Found by the fuzz sweep: a diameter of 5e-324 halves to 0, and the drive divided by it while stepping."""
+    sim = world_simulation(tmp_path)
+    try:
+        text = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>5e-324</{tag}>", urdf())
+        with pytest.raises(ConfigError, match=f"<{tag}> has bad value '5e-324': .* outside the valid range >= 0.001"):
+            sim.spawn_robot(parse_robot(text, "model 'skid'"), "skid")
+    finally:
+        sim.close()

@@ -11,9 +11,9 @@ from typing import NamedTuple, Optional, Tuple
 
 from . import names
 from .clock import UpdateTimer
-from .diff_drive import TwistCommand, yaw_rotated_velocity
+from .diff_drive import MINIMUM_WHEEL_SIZE, TwistCommand, yaw_rotated_velocity
 from .geometry import Pose, yaw
-from .params import Param, non_negative, positive, rate
+from .params import Param, non_negative, rate
 from .plugin import Plugin
 
 WHEEL_TAGS = ("leftFrontJoint", "rightFrontJoint", "leftRearJoint", "rightRearJoint")
@@ -36,8 +36,8 @@ class SkidSteerDrive(TwistCommand, Plugin):
         Param("rightFrontJoint", str, "right_front_joint", "wheel joint"),
         Param("leftRearJoint", str, "left_rear_joint", "wheel joint"),
         Param("rightRearJoint", str, "right_rear_joint", "wheel joint"),
-        positive("wheelSeparation", float, 0.4, "m between the left and right wheels"),
-        positive("wheelDiameter", float, 0.15, "m"),
+        Param("wheelSeparation", float, 0.4, "m between the left and right wheels", minimum=MINIMUM_WHEEL_SIZE),
+        Param("wheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
         non_negative("torque", float, 5.0, "N·m, the most each wheel motor gives"),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist subscribed"),
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry (ground truth)"),

@@ -22,9 +22,9 @@ from typing import NamedTuple, Optional, Tuple
 
 from . import names
 from .clock import UpdateTimer
-from .diff_drive import TwistCommand, yaw_rotated_velocity
+from .diff_drive import MINIMUM_WHEEL_SIZE, TwistCommand, yaw_rotated_velocity
 from .geometry import Pose, pose_from_xyz_rpy, yaw
-from .params import Param, non_negative, positive, rate
+from .params import Param, non_negative, rate
 from .plugin import Plugin
 from .ros_control.hardware_interface import UNBOUNDED_EFFORT
 
@@ -49,9 +49,9 @@ class TricycleDrive(TwistCommand, Plugin):
         Param("actuatedWheelJoint", str, "front_wheel_joint", "the driven wheel's joint"),
         Param("encoderWheelLeftJoint", str, "left_wheel_joint", "left encoder wheel's joint"),
         Param("encoderWheelRightJoint", str, "right_wheel_joint", "right encoder wheel's joint"),
-        positive("actuatedWheelDiameter", float, 0.15, "m"),
-        positive("encoderWheelDiameter", float, 0.15, "m"),
-        positive("encoderWheelSeparation", float, 0.5, "m between the encoder wheels"),
+        Param("actuatedWheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
+        Param("encoderWheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
+        Param("encoderWheelSeparation", float, 0.5, "m between the encoder wheels", minimum=MINIMUM_WHEEL_SIZE),
         non_negative("wheelTorque", float, 5.0, "N·m, the most the wheel and the steering motors give"),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist: linear.x wheel speed, angular.z steering angle"),
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry"),
