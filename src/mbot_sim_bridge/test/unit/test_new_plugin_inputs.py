@@ -69,7 +69,8 @@ def velodyne_urdf(tmp_path_factory):
 
 
 @pytest.mark.parametrize("text", BAD_TEXTS)
-@pytest.mark.parametrize("tag", ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples"])
+@pytest.mark.parametrize("tag", ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples",
+                                 "max_angle"])
 def test_velodyne_tags(tmp_path, velodyne_urdf, tag, text):
     urdf = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", velodyne_urdf)
     moved = run(tmp_path, urdf)

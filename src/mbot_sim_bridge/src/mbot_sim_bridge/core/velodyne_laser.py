@@ -90,7 +90,9 @@ class VelodyneLaser(RaySensor):
             ranges = ranges + self.noise_rng.normal(0.0, noise, ranges.size)
         # Organised, upstream checks the noisy range only: a ray dropped by the first check can come back.
         valid = (kept | organized) & (self.min_range < ranges) & (ranges < self.max_range)
-        xyz = (self.directions * ranges[:, np.newaxis]).astype(np.float32)
+        # Rays with no reading (an infinite range) are left out or made NaN below; multiplied out, inf times a
+        # direction's zero component gave NaN warnings first (a sweep ending at 0 rad has such directions).
+        xyz = (self.directions * np.where(valid, ranges, 0.0)[:, np.newaxis]).astype(np.float32)
         if organized:
             xyz[~valid] = np.nan
             intensity = np.where(valid, intensity, np.nan).astype(np.float32)
