@@ -9,21 +9,12 @@ import time
 import numpy as np
 import rospy
 from mbot_sim_bridge import loop_publishing
-from mbot_sim_bridge.core.imu import ImuReading, ImuReadings
+from mbot_sim_bridge.processes import wait_until
+from mbot_sim_bridge.core.sensors.imu import ImuReading, ImuReadings
 from mbot_sim_bridge.plugins.messages import imu_message, imu_records
 from geometry_msgs.msg import PointStamped
 from sensor_msgs.msg import Imu
 from std_msgs.msg import String
-
-
-def wait_until(condition, what, publish=None, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            sys.exit(f"timed out: {what}")
-        if publish is not None:
-            publish()
-        time.sleep(0.01)
 
 
 def serialized(message) -> bytes:
@@ -38,7 +29,7 @@ def check_records(publishing):
     imu = loop_publishing.LoopPublisher("/imu", Imu)
     received = []
     rospy.Subscriber("/imu", Imu, received.append)
-    wait_until(lambda: imu.get_num_connections() == 1, "the connection to /imu")
+    wait_until(lambda: imu.get_num_connections() == 1, 10.0, "the connection to /imu")
     rng = np.random.default_rng(3)
     orientations = rng.normal(size=(3, 4))
     readings = ImuReadings(np.array([0.001, 41.0025, 1e6 + 0.0000005]), orientations / np.linalg.norm(
@@ -49,7 +40,7 @@ def check_records(publishing):
     imu.publish_records(imu_records(readings, "imu_link"))
     imu.publish(imu_message(rows[0], "imu_link"))
     publishing.sync()
-    wait_until(lambda: len(received) == 4, "four /imu messages")
+    wait_until(lambda: len(received) == 4, 10.0, "four /imu messages")
     for seq, (message, row) in enumerate(zip(received, rows + rows[:1]), start=1):
         expected = imu_message(row, "imu_link")
         expected.header.seq = seq
@@ -67,7 +58,7 @@ def main():
     received, headers = [], []
     subscriber = rospy.Subscriber("/chatter", String, lambda message: received.append(message.data))
     rospy.Subscriber("/stamped", PointStamped, lambda message: headers.append(message.header.seq))
-    wait_until(lambda: chatter.get_num_connections() == 1 and stamped.get_num_connections() == 1, "connections")
+    wait_until(lambda: chatter.get_num_connections() == 1 and stamped.get_num_connections() == 1, 10.0, "connections")
 
     for number in range(300):
         chatter.publish(String(data=str(number)))
@@ -75,7 +66,7 @@ def main():
         if number % 7 == 0:
             publishing.flush()
     publishing.sync()
-    wait_until(lambda: len(received) == 300 and len(headers) == 300, "300 messages on each topic")
+    wait_until(lambda: len(received) == 300 and len(headers) == 300, 10.0, "300 messages on each topic")
     if received != [str(number) for number in range(300)] or headers != list(range(1, 301)):
         sys.exit(f"messages out of order or header.seq not counted: {received[:5]} {headers[:5]}")
     print("figure: 300 messages on each of two topics arrived in order, header.seq 1 to 300")
@@ -83,17 +74,23 @@ def main():
 
     # A subscriber that leaves is found by the writer and its connection closed in rospy.
     subscriber.unregister()
-    wait_until(lambda: chatter.get_num_connections() == 0, "the departed subscriber's connection closed",
-               publish=lambda: (chatter.publish(String(data="x")), publishing.flush()))
+
+    def departed() -> bool:
+        if chatter.get_num_connections() == 0:
+            return True
+        chatter.publish(String(data="x"))  # the writer finds the closed socket when it writes to it
+        publishing.flush()
+        return False
+    wait_until(departed, 10.0, "the departed subscriber's connection closed")
     print("figure: a departed subscriber's connection is closed in rospy")
 
     # A new subscriber receives, on a new connection.
     again = []
     rospy.Subscriber("/chatter", String, lambda message: again.append(message.data))
-    wait_until(lambda: chatter.get_num_connections() == 1, "the new connection")
+    wait_until(lambda: chatter.get_num_connections() == 1, 10.0, "the new connection")
     chatter.publish(String(data="again"))
     publishing.sync()
-    wait_until(lambda: again == ["again"], "a message on the new connection")
+    wait_until(lambda: again == ["again"], 10.0, "a message on the new connection")
     print("figure: a new subscriber receives on its new connection")
 
     # A publisher that unregisters: the writer closes its copies of the publisher's sockets too.
@@ -117,7 +114,7 @@ def main():
     publishing = loop_publishing.start()
     late = loop_publishing.LoopPublisher("/late", String)
     rospy.Subscriber("/late", String, lambda message: None)
-    wait_until(lambda: late.get_num_connections() == 1, "the connection to /late")
+    wait_until(lambda: late.get_num_connections() == 1, 10.0, "the connection to /late")
     publishing.process.kill()
     publishing.process.wait()
     late.publish(String(data="into the void"))
@@ -132,11 +129,11 @@ def main():
     direct = loop_publishing.LoopPublisher("/imu_direct", Imu)
     received = []
     rospy.Subscriber("/imu_direct", Imu, received.append)
-    wait_until(lambda: direct.get_num_connections() == 1, "the connection to /imu_direct")
+    wait_until(lambda: direct.get_num_connections() == 1, 10.0, "the connection to /imu_direct")
     readings = ImuReadings(np.array([0.5, 0.501]), np.array([[0.0, 0.0, 0.0, 1.0]] * 2), np.ones((2, 3)),
                            np.zeros((2, 3)), 0.0)
     direct.publish_records(imu_records(readings, "imu_link"))
-    wait_until(lambda: len(received) == 2, "two /imu_direct messages")
+    wait_until(lambda: len(received) == 2, 10.0, "two /imu_direct messages")
     if [message.header.stamp.to_sec() for message in received] != [0.5, 0.501] or \
             received[1].angular_velocity.z != 1.0 or received[1].header.frame_id != "imu_link":
         sys.exit(f"records published without a writer arrived wrong: {received}")

@@ -1,5 +1,5 @@
 """libgazebo_ros_imu.so at updateRate 0 through the bridge: a message per physics step in lockstep, recorded
-every step and sent in batches (core/imu.py), repeated byte for byte after reset_simulation."""
+every step and sent in batches (core/sensors/imu.py), repeated byte for byte after reset_simulation."""
 import os
 
 from mbot_sim_bridge.processes import stop_process_group

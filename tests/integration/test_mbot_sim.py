@@ -52,3 +52,17 @@ def test_sim_help_lists_each_worlds_arguments(tmp_path):
     assert result.returncode == 0, result.stderr
     assert "lockstep:=false    start paused; the simulation moves only through /gazebo/step_simulation" in result.stdout
     assert "world_name:=" in result.stdout and "x:=0    spawn x (m)" in result.stdout
+
+
+def test_shell_puts_the_workspace_after_the_users_bashrc(tmp_path):
+    # A ~/.bashrc that puts another python3 first (pyenv's and conda's do) must not hide the venv's.
+    decoy = tmp_path / "decoy_bin"
+    decoy.mkdir()
+    (decoy / "python3").write_text("#!/bin/sh\necho decoy\n")
+    (decoy / "python3").chmod(0o755)
+    (tmp_path / ".bashrc").write_text(f'export PATH="{decoy}:$PATH"\n')
+    result = subprocess.run([MBOT, "shell"], input='python3 -c "import rospy, xacro; print(\'workspace python\')"\n',
+                            env=dict(_environment(tmp_path), HOME=str(tmp_path)), capture_output=True, text=True,
+                            timeout=120)
+    assert "workspace python" in result.stdout, result.stdout + result.stderr
+    assert "decoy" not in result.stdout

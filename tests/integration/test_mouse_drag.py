@@ -17,10 +17,10 @@ import numpy as np
 import pybullet
 import pytest
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
-from mbot_sim_bridge.core.world_writer import take_snapshot, world_sdf, write_world_file
+from mbot_sim_bridge.core.description.world_writer import take_snapshot, world_sdf, write_world_file
 
 from xvfb import Xvfb
 

@@ -77,13 +77,8 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
         environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
         for attempt in range(1, RVIZ_ATTEMPTS + 1):
             log_path = tmp_path / (f"rviz-{attempt}.log")
-            with open(log_path, "w") as log:
-                rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
-                                        stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                        start_new_session=True)
+            rviz = start_rviz(config, environment, log_path, master, 30)
             try:
-                wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
-                           "rviz to register with the master")
                 image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image),
                               DRAW_TIMEOUT, STEADY)
                 crashed = rviz.poll() is not None
@@ -95,9 +90,7 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
             # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
             print(f"rviz exited with {rviz.returncode} on start {attempt}:\n{log_path.read_text()}")
         assert not crashed, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
-    if os.environ.get("MBOT_SCREENSHOT_DIR"):
-        os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
-        shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
+    keep_screenshot(screenshot)
 
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50, "the screen is blank " + where
@@ -148,6 +141,28 @@ def base_link_colour(robot_description):
 def published(master):
     publishers, _, _ = master.getSystemState()
     return {topic for topic, nodes in publishers if nodes}
+
+
+def start_rviz(config, environment, log_path, master, timeout):
+    """rviz on ``config``, its output in ``log_path``, once it has registered with the master (or exited); the
+    caller stops it."""
+    with open(log_path, "w") as log:
+        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+                                stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), timeout,
+                   "rviz to register with the master")
+    except BaseException:
+        stop_process_group(rviz)
+        raise
+    return rviz
+
+
+def keep_screenshot(path):
+    """A copy of a screenshot in $MBOT_SCREENSHOT_DIR, when it is set."""
+    if os.environ.get("MBOT_SCREENSHOT_DIR"):
+        os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
+        shutil.copy(path, os.environ["MBOT_SCREENSHOT_DIR"])
 
 
 def node_registered(master, name):

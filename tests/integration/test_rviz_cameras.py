@@ -8,8 +8,6 @@ repeated wheel states of the course's joint_state_publisher. MBOT_SCREENSHOT_DIR
 of each screenshot.
 """
 import os
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
@@ -18,8 +16,8 @@ import yaml
 from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
-from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, base_link_colour, colour_count, node_registered,
-                       parse_colour, published, view_3d, watch)
+from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, base_link_colour, colour_count, keep_screenshot,
+                       parse_colour, published, start_rviz, view_3d, watch)
 from xvfb import Xvfb
 
 CONFIG_DIR = os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config")
@@ -76,20 +74,13 @@ def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
     log_path = tmp_path / "rviz.log"
     with Xvfb(tmp_path / "xvfb.log") as server:
         environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
-        with open(log_path, "w") as log:
-            rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
-                                    stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                    start_new_session=True)
+        rviz = start_rviz(config, environment, log_path, master, 60)
         try:
-            wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 60,
-                       "rviz to register with the master")
             # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
             image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image), 120, 2.0)
         finally:
             stop_process_group(rviz)
-    if os.environ.get("MBOT_SCREENSHOT_DIR"):
-        os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
-        shutil.copy(screenshot, os.environ["MBOT_SCREENSHOT_DIR"])
+    keep_screenshot(screenshot)
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     view = view_3d(image, background)
     assert view is not None, "no 3D view " + where

@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 from mbot_sim_bridge.processes import stop_process_group
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 from ros_processes import TESTS, call_service, run, service_up, wait_until
 
@@ -119,6 +119,8 @@ def test_bad_input_one_line_each_and_paused_stays_paused(ros_env, launch, tmp_pa
 
     assert "as 'unit_sphere'" in ok(mbot_world(ros_env, "insert", "unit_sphere", "-z", "2"))
     assert paused(ros_env)
+    ode = call_service(ros_env, "/gazebo/get_physics_properties")["ode_config"]  # the world's, SDF's defaults
+    assert (ode["erp"], ode["contact_max_correcting_vel"], ode["contact_surface_layer"]) == (0.2, 100.0, 0.001)
     assert model_poses(ros_env)["unit_sphere"][0] == pytest.approx((0.0, 0.0, 2.0), abs=1e-6)  # no fall: paused
 
     for target in (tmp_path / "missing" / "out.world", tmp_path):

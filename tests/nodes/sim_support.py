@@ -1,12 +1,12 @@
 """Helpers shared by the rostest nodes: waiting on conditions, ground truth, driving through /cmd_vel."""
 import math
 import sys
-import time
 
 import rospy
 from controller_manager_msgs.srv import ListControllers
 from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
+from mbot_sim_bridge.processes import wait_until
 from std_srvs.srv import Empty
 
 # Wall-clock limits: generous, because CI machines are slow; a test fails only if a condition never comes.
@@ -14,14 +14,15 @@ WALL_TIMEOUT = 60.0
 
 
 def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
-    """Poll ``condition`` until it is true or ``timeout`` wall seconds pass (then AssertionError)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.01)
-    raise AssertionError(f"timed out after {timeout:.0f} s waiting for {what}")
+    """``condition``'s truthy value, polled for at most ``timeout`` wall seconds (then AssertionError)."""
+    return wait_until(condition, timeout, what)
+
+
+def twist(linear=0.0, angular=0.0) -> Twist:
+    """A planar base's command: linear.x and angular.z."""
+    message = Twist()
+    message.linear.x, message.angular.z = linear, angular
+    return message
 
 
 def print_figures(lines):
@@ -94,9 +95,7 @@ class Simulator:
         return state.header.stamp.to_sec(), state.pose, state.twist
 
     def command(self, linear=0.0, angular=0.0):
-        twist = Twist()
-        twist.linear.x, twist.angular.z = linear, angular
-        self.cmd_vel.publish(twist)
+        self.cmd_vel.publish(twist(linear, angular))
 
     def wait_sim_time(self, seconds):
         """Wait until ``seconds`` of sim time have passed; returns the ground truth then."""

@@ -12,7 +12,7 @@ import numpy
 import rospy
 import rostest
 from mbot_gazebo.footprints import footprint
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from sensor_msgs.msg import LaserScan
 
 from sim_support import Simulator, wait_for

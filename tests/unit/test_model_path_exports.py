@@ -5,7 +5,7 @@ import os
 import textwrap
 
 import pytest
-from mbot_sim_bridge.core.model_path import find_model_directory, find_world_file
+from mbot_sim_bridge.core.description.model_path import find_model_directory, find_world_file
 from mbot_sim_bridge.gazebo_paths import model_path as default_model_path
 from mbot_sim_bridge.gazebo_paths import package_exports, prefetch_package_exports
 from mbot_sim_bridge.gazebo_paths import resource_path as default_resource_path

@@ -30,15 +30,14 @@ WHEELS = ("left_wheel_joint", "right_wheel_joint")
 
 
 def raw_pybullet_rtf(sim_seconds: float) -> float:
-    import xacro_noetic as xacro
-    from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
+    from mbot_sim_bridge.core.drives.diff_drive import DiffDriveGeometry, WheelSpeedRamp
     from mbot_sim_bridge.core.engine import Engine
-    from mbot_sim_bridge.core.robot_model import parse_robot
-    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.description.robot_model import parse_robot
+    from mbot_sim_bridge.core.description.sdf_world import parse_world
     from mbot_sim_bridge.core.world_bodies import load_world
+    from mbot_sim_bridge.robot_description import expand_xacro
 
-    urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
-                                           "mbot_gazebo.xacro")).toxml()
+    urdf = expand_xacro(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo", "mbot_gazebo.xacro"))
     engine = Engine()
     engine.add_world(load_world(engine.client, parse_world(os.path.join(WORKSPACE, "worlds", "empty.world"))))
     robot = engine.spawn_robot(parse_robot(urdf), "mbot", driven_joints=WHEELS)

@@ -26,15 +26,16 @@ sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
 
 from sensor_msgs.msg import Image  # noqa: E402 (after the path set-up)
 
-from mbot_sim_bridge.core.camera import Camera, DepthCamera  # noqa: E402
-from mbot_sim_bridge.core.diff_drive import DiffDrive  # noqa: E402
-from mbot_sim_bridge.core.imu import ImuModelPlugin  # noqa: E402
+from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera  # noqa: E402
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive  # noqa: E402
+from mbot_sim_bridge.core.sensors.imu import ImuModelPlugin  # noqa: E402
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS  # noqa: E402
-from mbot_sim_bridge.core.render_scene import RENDERER_ENV  # noqa: E402
-from mbot_sim_bridge.core.robot_model import parse_robot  # noqa: E402
-from mbot_sim_bridge.core.sdf_world import parse_world  # noqa: E402
+from mbot_sim_bridge.core.cameras.render_scene import RENDERER_ENV  # noqa: E402
+from mbot_sim_bridge.core.description.robot_model import parse_robot  # noqa: E402
+from mbot_sim_bridge.core.description.sdf_world import parse_world  # noqa: E402
 from mbot_sim_bridge.core.simulation import Simulation  # noqa: E402
 from mbot_sim_bridge.plugins.messages import imu_records  # noqa: E402
+from mbot_sim_bridge.robot_description import expand_xacro  # noqa: E402
 
 PLAY_GROUND = os.path.join(WORKSPACE, "src", "mbot_gazebo", "worlds", "playground.world")
 SIZES = ((320, 240), (640, 480), (1280, 720))
@@ -52,9 +53,8 @@ IMU_BLOCK = """<link name="imu_link"/>
 def course_urdf(name: str) -> str:
     package_path = os.environ.get("ROS_PACKAGE_PATH", "")
     os.environ["ROS_PACKAGE_PATH"] = os.path.join(WORKSPACE, "src") + os.pathsep + package_path
-    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo", name + ".xacro")
-    return xacro.process_file(path).toxml()
+    return expand_xacro(path)
 
 
 def spawn(urdf: str):

@@ -16,7 +16,7 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from mbot_sim_bridge.core.geometry import compose, pose_from_xyz_rpy, rotation_matrix
-from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig
+from mbot_sim_bridge.core.sensors.lidar import LaserScanner, RaySensorConfig
 from mbot_sim_bridge.core.log import c_stdout_to
 
 

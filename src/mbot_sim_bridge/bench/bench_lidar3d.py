@@ -19,18 +19,18 @@ from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
 from sensor_msgs.msg import PointCloud2
 
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
-from mbot_sim_bridge.core.velodyne_laser import VelodyneLaser
+from mbot_sim_bridge.core.sensors.velodyne_laser import VelodyneLaser
 from mbot_sim_bridge.package_uris import resolve_package_uris
 from mbot_sim_bridge.plugins.gazebo_ros_velodyne_laser import FIELDS, POINT
+from mbot_sim_bridge.robot_description import expand_xacro
 
 
 def rover_urdf(lidar: bool) -> str:
-    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "rover_description", "urdf", "rover.urdf.xacro")
-    return resolve_package_uris(xacro.process_file(path, mappings={"lidar_3d_enabled": str(lidar).lower()}).toxml())
+    return resolve_package_uris(expand_xacro(path, lidar_3d_enabled=str(lidar).lower()))
 
 
 def spawn(lidar: bool):

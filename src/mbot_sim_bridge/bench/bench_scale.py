@@ -25,16 +25,16 @@ BOXES = 5000
 
 
 def raw_robots_rtf(robots: int, sim_seconds: float) -> float:
-    import xacro_noetic as xacro
-    from mbot_sim_bridge.core.diff_drive import DiffDrive
+    from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
     from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-    from mbot_sim_bridge.core.robot_model import parse_robot
-    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.description.robot_model import parse_robot
+    from mbot_sim_bridge.core.description.sdf_world import parse_world
     from mbot_sim_bridge.core.simulation import Simulation
+    from mbot_sim_bridge.robot_description import expand_xacro
 
-    urdf = xacro.process_file(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
-                                           "mbot_with_laser_gazebo.xacro"), mappings={}).toxml()
+    urdf = expand_xacro(os.path.join(WORKSPACE, "src", "mbot_description", "urdf", "gazebo",
+                                     "mbot_with_laser_gazebo.xacro"))
     sim = Simulation(parse_world(os.path.join(WORKSPACE, "worlds", "playground.world")), CORE_PLUGINS)
     for index in range(robots):  # the places and turn rates of multi_mbot.launch and the bridge run below
         place = pose_from_xyz_rpy((-1.0 + 0.8 * (index % 5), -0.5 + 1.0 * (index // 5), 0), (0, 0, 0))
@@ -67,7 +67,7 @@ def box_world(path: str):
 
 def raw_boxes_rtf(world_path: str, sim_seconds: float) -> float:
     from mbot_sim_bridge.core.engine import Engine
-    from mbot_sim_bridge.core.sdf_world import parse_world
+    from mbot_sim_bridge.core.description.sdf_world import parse_world
     from mbot_sim_bridge.core.world_bodies import load_world
 
     engine = Engine()

@@ -16,18 +16,18 @@ import time
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
 from sensor_msgs.msg import Image
 
-from mbot_sim_bridge.core.multicamera import MultiCamera
+from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.robot_description import expand_xacro
 
 
 def spawn():
-    import xacro_noetic as xacro
     path = os.path.join(WORKSPACE, "src", "mobile_test_robots", "urdf", "stereo_head.urdf.xacro")
     sim = Simulation(parse_world(PLAY_GROUND), CORE_PLUGINS)
-    urdf = xacro.process_file(path, mappings={}).toxml()
+    urdf = expand_xacro(path)
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'stereo_head'"), "stereo_head")
     return sim, next(plugin for plugin in spawned.plugins if isinstance(plugin, MultiCamera))
 

@@ -8,20 +8,10 @@ import termios
 import threading
 import time
 
-from mbot_sim_bridge.processes import stop_process_group
+from mbot_sim_bridge.processes import stop_process_group, wait_until  # noqa: F401 (the tests take it from here)
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TELEOP_SCRIPT = os.path.join(PACKAGE_DIR, 'scripts', 'mbot_teleop.py')
-
-
-def wait_until(condition, timeout, interval=0.02):
-    """Poll condition until it returns a truthy value (returned) or timeout seconds pass (None)."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = condition()
-        if value or time.monotonic() > deadline:
-            return value or None
-        time.sleep(interval)
 
 
 def teleop_command(*ros_args):

@@ -1,24 +1,72 @@
 """The generated gazebo_msgs types carry gazebo_ros_pkgs' (noetic-devel) md5 sums, computed with genmsg from
-upstream's definitions, so nodes built against upstream's gazebo_msgs talk to the bridge."""
+upstream's definitions, so nodes built against upstream's gazebo_msgs talk to the bridge; and every one of
+upstream's 11 messages and 23 services is generated."""
 import pytest
 
 import gazebo_msgs.msg as msg
 import gazebo_msgs.srv as srv
 
-UPSTREAM_MD5 = {
-    msg.ContactState: "48c0ffb054b8c444f870cecea1ee50d9",
-    msg.ContactsState: "acbcb1601a8e525bf72509f18e6f668d",
-    msg.ModelStates: "48c080191eb15c41858319b4d8a609c2",
-    msg.ModelState: "9330fd35f2fcd82d457e54bd54e10593",
-    msg.LinkState: "0818ebbf28ce3a08d48ab1eaa7309ebe",
-    srv.SpawnModel: "9ed9c82c96abe1a00c3e8cdaeee24413",
-    srv.GetModelState: "4c515e936d3319c9610c559c60bfc3d4",
-    srv.SetModelState: "5b3ab0281d4f5445def017e3a2e4a07b",
-    srv.ApplyBodyWrench: "585b9f9618aa0581b207e2f2d90866bc",
-    srv.BodyRequest: "5eade9afe7f232d78005bd0cafeab755",
+UPSTREAM_MESSAGE_MD5 = {
+    "ContactState": "48c0ffb054b8c444f870cecea1ee50d9",
+    "ContactsState": "acbcb1601a8e525bf72509f18e6f668d",
+    "LinkState": "0818ebbf28ce3a08d48ab1eaa7309ebe",
+    "LinkStates": "48c080191eb15c41858319b4d8a609c2",
+    "ModelState": "9330fd35f2fcd82d457e54bd54e10593",
+    "ModelStates": "48c080191eb15c41858319b4d8a609c2",
+    "ODEJointProperties": "1b744c32a920af979f53afe2f9c3511f",
+    "ODEPhysics": "667d56ddbd547918c32d1934503dc335",
+    "PerformanceMetrics": "884f71fd5037b886ec5e126b83c4425a",
+    "SensorPerformanceMetric": "01762ded18cfe9ebc7c8222667c99547",
+    "WorldState": "de1a9de3ab7ba97ac0e9ec01a4eb481e",
+}
+UPSTREAM_SERVICE_MD5 = {
+    "ApplyBodyWrench": "585b9f9618aa0581b207e2f2d90866bc",
+    "ApplyJointEffort": "c0039811b8cc919490b3cff748cdf46b",
+    "BodyRequest": "5eade9afe7f232d78005bd0cafeab755",
+    "DeleteLight": "ae11ea8100d536d5b92c2b5917abf912",
+    "DeleteModel": "9ce56b4e9e54616de25d796dc972a262",
+    "GetJointProperties": "7b30be900f50aa21efec4a0ec92d91c9",
+    "GetLightProperties": "df2cef87e13e2e6990e81e8aaa454c19",
+    "GetLinkProperties": "0e06a70386d0ee3fb880c02f23fcd821",
+    "GetLinkState": "09d6c98cce97b35f7ab9bd70300657ab",
+    "GetModelProperties": "5717f7bd34ed990fa80e28b3015027a3",
+    "GetModelState": "4c515e936d3319c9610c559c60bfc3d4",
+    "GetPhysicsProperties": "575a5e74786981b7df2e3afc567693a6",
+    "GetWorldProperties": "36bb0f2eccf4d8be971410c22818ba3f",
+    "JointRequest": "0be1351618e1dc030eb7959d9a4902de",
+    "SetJointProperties": "15a76e921b1410c698d82782ea5fa370",
+    "SetJointTrajectory": "88f5c10979e3f9649d5ae87a3b12aa65",
+    "SetLightProperties": "e6f13430c57278bb364aca53a1bf5ebf",
+    "SetLinkProperties": "d534ce1b36ee99de0ffa806c3a6348f0",
+    "SetLinkState": "8a5146eb66ae4d26b0860b08f3f271be",
+    "SetModelConfiguration": "10e3139d3b669c40afc057d38956fff7",
+    "SetModelState": "5b3ab0281d4f5445def017e3a2e4a07b",
+    "SetPhysicsProperties": "97e2057080558ce4730434b5fae75c91",
+    "SpawnModel": "9ed9c82c96abe1a00c3e8cdaeee24413",
 }
 
 
-@pytest.mark.parametrize("message_type", list(UPSTREAM_MD5), ids=lambda t: t._type)
-def test_md5_matches_upstream(message_type):
-    assert message_type._md5sum == UPSTREAM_MD5[message_type]
+@pytest.mark.parametrize("name", list(UPSTREAM_MESSAGE_MD5))
+def test_message_md5_matches_upstream(name):
+    message_type = getattr(msg, name)
+    assert message_type._type == f"gazebo_msgs/{name}"
+    assert message_type._md5sum == UPSTREAM_MESSAGE_MD5[name]
+    message_type()  # constructs with defaults
+
+
+@pytest.mark.parametrize("name", list(UPSTREAM_SERVICE_MD5))
+def test_service_md5_matches_upstream(name):
+    service_type = getattr(srv, name)
+    assert service_type._type == f"gazebo_msgs/{name}"
+    assert service_type._md5sum == UPSTREAM_SERVICE_MD5[name]
+    service_type._request_class()
+    service_type._response_class()
+
+
+def test_no_other_types_are_generated():
+    """A type added here without its upstream md5 in the tables above fails."""
+    generated_messages = {name for name in dir(msg) if isinstance(getattr(msg, name), type)
+                          and hasattr(getattr(msg, name), "_md5sum")}
+    generated_services = {name for name in dir(srv) if hasattr(getattr(srv, name), "_request_class")}
+    assert generated_messages == set(UPSTREAM_MESSAGE_MD5)
+    assert generated_services == set(UPSTREAM_SERVICE_MD5)

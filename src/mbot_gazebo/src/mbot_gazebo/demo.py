@@ -22,7 +22,7 @@ import rospy
 import tf2_ros
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.log import c_stdout_to, get_logger
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.lockstep import LockstepClient
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
@@ -246,16 +246,17 @@ def core_logs_to(path: str):
 
 def camera_frame(world_path: str, x: float, y: float, yaw: float, log_path: str):
     """What the course's kinect would see from the robot's final pose: one frame of the same camera code the
-    simulator runs (core/camera.py), rendered in a world of its own, without ROS; its logs go to ``log_path``."""
-    import xacro_noetic as xacro
-    from mbot_sim_bridge.core.camera import DepthCamera
+    simulator runs (core/cameras/camera.py), rendered in a world of its own, without ROS; its logs go to
+    ``log_path``."""
+    from mbot_sim_bridge.core.cameras.camera import DepthCamera
     from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
     from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-    from mbot_sim_bridge.core.robot_model import parse_robot
+    from mbot_sim_bridge.core.description.robot_model import parse_robot
     from mbot_sim_bridge.core.simulation import Simulation
+    from mbot_sim_bridge.robot_description import expand_xacro
 
-    urdf = xacro.process_file(os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
-                                           "mbot_with_kinect_gazebo.xacro")).toxml()
+    urdf = expand_xacro(os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",
+                                     "mbot_with_kinect_gazebo.xacro"))
     with core_logs_to(log_path):
         simulation = Simulation(parse_world(world_path), CORE_PLUGINS)
         try:

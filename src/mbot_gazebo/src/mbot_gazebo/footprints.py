@@ -3,7 +3,7 @@ run, the room-scan test): each shape's footprint as a convex polygon in the worl
 from typing import Tuple
 
 import numpy as np
-from mbot_sim_bridge.core.world_description import Shape
+from mbot_sim_bridge.core.description.world_description import Shape
 
 Polygon = Tuple[Tuple[float, float], ...]
 

@@ -8,11 +8,11 @@ import os
 import xml.etree.ElementTree as ET
 from typing import List, NamedTuple, Optional, Sequence
 
-from mbot_sim_bridge.core.model_path import MODEL_MANIFESTS
+from mbot_sim_bridge.core.description.model_path import MODEL_MANIFESTS
 from mbot_sim_bridge.gazebo_paths import model_path as exported_model_path
 
-# Gazebo ships these and so does the bridge (core.sdf_world.BUILTIN_MODEL_NAMES, checked by a test; not imported
-# because it brings in PyBullet, which prints its build time); a model of the same name on the path wins.
+# Gazebo ships these and so does the bridge (core.description.sdf_world.BUILTIN_MODEL_NAMES, checked by a test; not
+# imported because it brings in PyBullet, which prints its build time); a model of the same name on the path wins.
 BUILTIN_MODELS = {"ground_plane": "Gazebo's ground plane: a static 100 x 100 m plane (built in)",
                   "sun": "Gazebo's directional light (built in; not simulated, kept when a world is saved)"}
 

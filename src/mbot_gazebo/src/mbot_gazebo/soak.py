@@ -32,8 +32,8 @@ from geometry_msgs.msg import Twist
 from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.geometry import Pose
 from mbot_sim_bridge.gazebo_paths import model_path
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock

@@ -7,7 +7,7 @@ from PIL import Image
 
 from mbot_gazebo.demo import camera_frame
 from mbot_gazebo.demo_plot import IMAGE_SIZE, draw_demo
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
 PLAYGROUND = os.path.join(REPO, "worlds", "playground.world")

@@ -8,7 +8,7 @@ from PIL import Image
 
 from mbot_gazebo.footprints import footprint
 from mbot_gazebo.demo_plot import IMAGE_SIZE, OBSTACLE_COLOUR, PATH_COLOUR, SCAN_COLOUR, PlotFrame, draw_demo
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
 PLAYGROUND = os.path.join(REPO, "worlds", "playground.world")

@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from mbot_gazebo.floorplan import FloorPlanError, load_floor_plan, main, merge_cells, world_sdf
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
 
 PACKAGE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))

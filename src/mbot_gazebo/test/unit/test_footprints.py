@@ -2,7 +2,7 @@
 import math
 
 import pytest
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 from mbot_gazebo.footprints import footprint
 

@@ -7,8 +7,8 @@ import pytest
 
 from mbot_gazebo.model_library import (BUILTIN_MODELS, UnknownModel, find_model, format_table, instance_name,
                                        list_models)
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import BUILTIN_MODEL_NAMES, parse_world
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import BUILTIN_MODEL_NAMES, parse_world
 from mbot_sim_bridge.core.geometry import IDENTITY
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -10,7 +10,7 @@ import subprocess
 from typing import Dict, List
 
 from .core.log import get_logger, warn_once
-from .core.model_path import default_model_path, default_resource_path
+from .core.description.model_path import default_model_path, default_resource_path
 
 # rospack answers from its cache in milliseconds; a first crawl of a large ROS_PACKAGE_PATH takes longer.
 _ROSPACK_TIMEOUT_SECONDS = 60.0

@@ -15,7 +15,7 @@ import sys
 import rospkg
 import rospy
 
-from .core.model_path import find_world_file
+from .core.description.model_path import find_world_file
 from .gazebo_paths import prefetch_package_exports, resource_path
 
 # gazebo_ros's system plugins: the bridge is both of them.

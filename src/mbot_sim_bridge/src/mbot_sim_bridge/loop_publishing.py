@@ -25,7 +25,7 @@ import rospy
 from rospy.msg import serialize_message
 
 from . import wire_writer
-from .wire_writer import CLOSE, DATA, DATA_HEADER, DEAD, ID, OPEN, SYNC, SYNCED
+from .wire_writer import CLOSE, DATA, DATA_HEADER, DEAD, ID, OPEN, SLOW, SYNC, SYNCED
 
 _STOP_SECONDS = 1.0
 _ANSWERS_READ_SECONDS = 0.05
@@ -180,11 +180,20 @@ class LoopPublishing:
             for kind, number in ID.iter_unpack(bytes(self._answers[:usable])):
                 if kind == DEAD:
                     self._close_dead(number)
+                elif kind == SLOW:
+                    self._report_slow(number)
                 elif kind == SYNCED and number == token:
                     synced = True
             del self._answers[:usable]
             if synced:
                 return
+
+    def _report_slow(self, number: int):
+        connection = self._connections.get(number)
+        if connection is not None:
+            rospy.logwarn(f"{connection.endpoint_id} does not keep up with {connection.name}: the simulator drops "
+                          "its oldest messages for it rather than wait (as a roscpp publisher's queue does); said "
+                          "once per subscriber")
 
     def _close_dead(self, number: int):
         connection = self._connections.pop(number, None)

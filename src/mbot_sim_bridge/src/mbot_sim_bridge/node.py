@@ -21,7 +21,7 @@ from rosgraph_msgs.msg import Clock
 from .core.clock import UpdateTimer
 from .core.errors import BridgeError, WorldError
 from .gazebo_paths import model_path
-from .core.sdf_world import parse_world
+from .core.description.sdf_world import parse_world
 from .core.simulation import MAX_BATCH_SIM_SECONDS, Simulation
 from .core.xml_values import parse_bool
 from . import loop_publishing

@@ -1,7 +1,7 @@
-"""Processes, for every package of the workspace: a private master on a free port and a clean stop of a launched
-process group (the demo, the benchmarks, the tests), a process's own stop request on SIGINT/SIGTERM (the
-simulator node, ``./mbot sim``, the spawner and the unspawner), and for the nodes on the way to the first /odom,
-rospy's init_node without its slow poll and a start-up without garbage collection."""
+"""Processes, for every package of the workspace: a private master on a free port, a clean stop of a launched
+process group and waiting on a condition (the demo, the benchmarks, the tests), a process's own stop request on
+SIGINT/SIGTERM (the simulator node, ``./mbot sim``, the spawner and the unspawner), and for the nodes on the way
+to the first /odom, rospy's init_node without its slow poll and a start-up without garbage collection."""
 import gc
 import os
 import signal
@@ -17,6 +17,21 @@ def free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
+
+
+def wait_until(condition, timeout: float, what: str = None, interval: float = 0.02):
+    """Poll ``condition`` every ``interval`` wall seconds until it returns a truthy value, which is returned; after
+    ``timeout`` seconds an AssertionError naming ``what``, or None when ``what`` is None (the caller decides)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            if what is None:
+                return None
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(interval)
 
 
 def ignores_signal(pid: int, signum: int) -> bool:

@@ -14,6 +14,8 @@ from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, BodyReque
                              GetPhysicsProperties, GetPhysicsPropertiesResponse, GetWorldProperties,
                              GetWorldPropertiesResponse, SetModelState, SetModelStateResponse, SpawnModel,
                              SpawnModelResponse)
+from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelProperties, GetModelPropertiesResponse,
+                             SetModelConfiguration, SetModelConfigurationResponse)
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
@@ -23,9 +25,9 @@ from .core.engine import check_model_name, check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .gazebo_paths import model_path
-from .core.robot_model import parse_robot
-from .core.sdf_spawn import spawn_world_xml
-from .core.sdf_world import parse_world
+from .core.description.robot_model import parse_robot
+from .core.description.sdf_spawn import spawn_world_xml
+from .core.description.sdf_world import parse_world
 from .model_states import ModelStatesPublisher
 from .package_uris import resolve_package_uris
 from .plugins import ros_time
@@ -38,6 +40,8 @@ LOCKSTEP_DRAIN_SECONDS = 5.0
 # One step_simulation call covers at most this much sim time: the largest uint32 count would hold the
 # simulator (and every other request) for days.
 MAX_STEP_SIM_SECONDS = 3600.0
+# Upstream's answer; the joints a request names but the model lacks are added after it.
+SET_MODEL_CONFIGURATION_SUCCESS = "SetModelConfiguration: success"
 
 
 def _pose_from_message(message: PoseMessage) -> Pose:
@@ -87,6 +91,9 @@ class GazeboRosApi:
             rospy.Service("~apply_body_wrench", ApplyBodyWrench, self._apply_body_wrench),
             rospy.Service("~clear_body_wrenches", BodyRequest, self._clear_body_wrenches),
             rospy.Service("~step_simulation", StepSimulation, self._step_simulation),
+            rospy.Service("~set_model_configuration", SetModelConfiguration, self._set_model_configuration),
+            rospy.Service("~get_model_properties", GetModelProperties, self._get_model_properties),
+            rospy.Service("~get_link_state", GetLinkState, self._get_link_state),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -248,8 +255,43 @@ class GazeboRosApi:
                                                     max_update_rate=physics.real_time_update_rate,
                                                     success=True, status_message="")
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
+            ode = response.ode_config
+            ode.erp, ode.contact_max_correcting_vel = physics.erp, physics.contact_max_correcting_vel
+            ode.contact_surface_layer = physics.contact_surface_layer
             return response
         return self._guarded(GetPhysicsPropertiesResponse, get)
+
+    # -- joints --------------------------------------------------------------------------------------------------
+    def _set_model_configuration(self, request):
+        def set_configuration():
+            missing = self.sim.set_model_configuration(request.model_name, request.joint_names,
+                                                       request.joint_positions)
+            message = SET_MODEL_CONFIGURATION_SUCCESS
+            if missing:
+                message += (f"; model '{request.model_name}' has no movable joint "
+                            f"{', '.join(repr(name) for name in missing)} (ignored)")
+                rospy.logwarn(message)
+            return SetModelConfigurationResponse(success=True, status_message=message)
+        return self._guarded(SetModelConfigurationResponse, set_configuration)
+
+    # -- model and link queries ------------------------------------------------------------------------------------
+    def _get_model_properties(self, request):
+        def get():
+            properties = self.sim.model_properties(request.model_name)
+            return GetModelPropertiesResponse(body_names=properties.body_names, geom_names=properties.geom_names,
+                                              joint_names=properties.joint_names, is_static=properties.is_static,
+                                              success=True, status_message="GetModelProperties: got properties")
+        return self._guarded(GetModelPropertiesResponse, get)
+
+    def _get_link_state(self, request):
+        def get():
+            pose, linear, angular = self.sim.link_state(request.link_name, request.reference_frame)
+            response = GetLinkStateResponse(success=True, status_message="GetLinkState: got state")
+            state = response.link_state
+            state.link_name, state.reference_frame = request.link_name, request.reference_frame
+            state.pose, state.twist = _pose_to_message(pose), _twist_message(linear, angular)
+            return response
+        return self._guarded(GetLinkStateResponse, get)
 
 
 def _refused(response_type, error: BridgeError):

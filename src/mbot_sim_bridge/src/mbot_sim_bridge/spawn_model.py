@@ -10,7 +10,7 @@ from xml.etree import ElementTree
 
 import rosgraph
 import rospy
-from gazebo_msgs.srv import DeleteModel, SpawnModel
+from gazebo_msgs.srv import DeleteModel, GetPhysicsProperties, SetModelConfiguration, SpawnModel
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty
 
@@ -39,7 +39,7 @@ def parse_arguments(argv):
     for axis in ("x", "y", "z", "R", "P", "Y"):
         parser.add_argument("-" + axis, type=float, default=0.0, help=f"initial {axis} (m or rad)")
     parser.add_argument("-J", nargs=2, action="append", metavar=("JOINT", "POSITION"), default=[],
-                        help="not supported by the bridge (refused with an error)")
+                        help="set JOINT to POSITION (rad or m) before the model's first step; repeatable")
     parser.add_argument("-reference_frame", default="", help="pose relative to this model ('' = world)")
     parser.add_argument("-robot_namespace", default=None, help="namespace injected into the model's plugins "
                         "(default: this node's namespace)")
@@ -55,8 +55,10 @@ def parse_arguments(argv):
     arguments = parser.parse_args(argv)
     if arguments.timeout is not None and not 0 < arguments.timeout < float("inf"):
         parser.error(f"-timeout must be a number of seconds > 0, got {arguments.timeout}")
-    if arguments.J:
-        parser.error("-J (set_model_configuration) is not supported by the bridge")
+    try:
+        arguments.J = [(joint, float(position)) for joint, position in arguments.J]
+    except ValueError as error:
+        parser.error(f"-J takes a joint name and a position (a number): {error}")
     return arguments
 
 
@@ -143,15 +145,48 @@ def spawn(arguments):
         wait_for_model(arguments)
     wait_for_service(service_name, arguments.timeout)
     namespace = arguments.robot_namespace if arguments.robot_namespace is not None else rospy.get_namespace()
-    response = rospy.ServiceProxy(service_name, SpawnModel)(arguments.model, model_xml, namespace,
-                                                            initial_pose(arguments), arguments.reference_frame)
-    if not response.success:
-        raise SpawnError(f"spawning '{arguments.model}' failed: {response.status_message}")
-    rospy.loginfo(f"spawned '{arguments.model}': {response.status_message}")
+    # With -J the physics is held paused from the spawn to the joints' setting, so the model's first step starts
+    # from them (gazebo_ros's spawn_model sets them afterwards, while the model may already be falling).
+    resume = bool(arguments.J) and not physics_paused(arguments)
+    if resume:
+        call_empty(arguments, "pause_physics")
+    try:
+        response = rospy.ServiceProxy(service_name, SpawnModel)(arguments.model, model_xml, namespace,
+                                                                initial_pose(arguments), arguments.reference_frame)
+        if not response.success:
+            raise SpawnError(f"spawning '{arguments.model}' failed: {response.status_message}")
+        rospy.loginfo(f"spawned '{arguments.model}': {response.status_message}")
+        if arguments.J:
+            set_joints(arguments)
+    finally:
+        if resume:
+            call_empty(arguments, "unpause_physics")
     if arguments.unpause:
-        unpause_name = arguments.gazebo_namespace + "/unpause_physics"
-        wait_for_service(unpause_name, arguments.timeout)
-        rospy.ServiceProxy(unpause_name, Empty)()
+        call_empty(arguments, "unpause_physics")
+
+
+def physics_paused(arguments) -> bool:
+    name = arguments.gazebo_namespace + "/get_physics_properties"
+    wait_for_service(name, arguments.timeout)
+    return rospy.ServiceProxy(name, GetPhysicsProperties)().pause
+
+
+def call_empty(arguments, service: str):
+    name = f"{arguments.gazebo_namespace}/{service}"
+    wait_for_service(name, arguments.timeout)
+    rospy.ServiceProxy(name, Empty)()
+
+
+def set_joints(arguments):
+    """-J through set_model_configuration; joints the model lacks are named in one line, and the rest set."""
+    name = arguments.gazebo_namespace + "/set_model_configuration"
+    wait_for_service(name, arguments.timeout)
+    joints, positions = zip(*arguments.J)
+    response = rospy.ServiceProxy(name, SetModelConfiguration)(arguments.model, "", joints, positions)
+    if not response.success:
+        raise SpawnError(f"'{arguments.model}' spawned, but -J was refused: {response.status_message}")
+    if response.status_message != "SetModelConfiguration: success":
+        print(f"spawn_model: -J: {response.status_message}", file=sys.stderr)
 
 
 def main():

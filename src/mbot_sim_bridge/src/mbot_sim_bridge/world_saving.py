@@ -2,7 +2,7 @@
 
 Gazebo saves from its GUI menu and gazebo_ros has no service for it; this one is the bridge's. The loop
 thread takes a snapshot (every world model's description and pose now, the URDF robots' link poses); the
-SDF is written in the service's thread by ``core.world_writer``, to a temp file renamed over the target.
+SDF is written in the service's thread by ``core.description.world_writer``, to a temp file renamed over the target.
 """
 import os
 from typing import Callable
@@ -11,8 +11,8 @@ import rospy
 from mbot_sim_msgs.srv import SaveWorldResponse
 
 from .core.errors import BridgeError, WorldError
-from .core.world_description import WorldDescription
-from .core.world_writer import WorldSnapshot, take_snapshot, world_sdf, write_world_file
+from .core.description.world_description import WorldDescription
+from .core.description.world_writer import WorldSnapshot, take_snapshot, world_sdf, write_world_file
 
 PLUGINS_AS_TAGS = ("robots are written as inline SDF models; their plugins are kept as <plugin> tags, which "
                    "Gazebo loads but the bridge does not run for SDF models")

@@ -1,20 +1,19 @@
 """Shared builders for the ros_control tests: a Simulation with a robot whose gazebo_ros_control finds its
 controller YAML on a parameter tree, and controller switches as the service performs them."""
-import math
 import os
 import threading
 
 import yaml
+from sensor_fixtures import WORKSPACE_SRC
 
-from mbot_sim_bridge.core.gazebo_ros_control import GazeboRosControlPlugin
-from mbot_sim_bridge.core.geometry import yaw
+from mbot_sim_bridge.core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.parameters import Parameters
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.robot_description import expand_xacro
 
-WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
 WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
 MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
 ROBOTS = os.path.join(WORKSPACE_SRC, "ros_control_test_robots")
@@ -75,9 +74,7 @@ def recording_batches(sim):
 
 
 def expand_xacro_arm(interface):
-    import xacro_noetic as xacro
-    return xacro.process_file(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"),
-                              mappings={"interface": interface}).toxml()
+    return expand_xacro(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"), interface=interface)
 
 
 def arm(interface):
@@ -92,27 +89,6 @@ def start_controllers(sim, plugin, *names):
         assert manager.load(name, plugin.urdf), f"{name} did not load"
     assert switch(sim, manager, list(names))
     return manager.find(names[0]).controller
-
-
-def measured_motion(sim, spawned, controller, linear, angular, settle=1.5, window=1.0):
-    """Command (re-sent well within cmd_vel_timeout), settle, then ground truth over a window: the mean forward
-    speed in the robot's own frame (a chord would shorten arcs) and the heading change per second."""
-    forward_speeds = []
-
-    def run(seconds, record):
-        for _ in range(int(round(seconds / 0.05))):
-            controller.set_command(linear, angular, sim.sim_time)
-            sim.step(50)
-            if record:
-                velocity, _ = spawned.robot.root_velocity()
-                heading = yaw(spawned.robot.root_pose().orientation)
-                forward_speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
-    run(settle, False)
-    start, heading0 = sim.sim_time, yaw(spawned.robot.root_pose().orientation)
-    run(window, True)
-    dt = sim.sim_time - start
-    return (sum(forward_speeds) / len(forward_speeds),
-            math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi) / dt)
 
 
 def run_until_ended(sim, controller, seconds=10.0):

@@ -5,8 +5,13 @@ import os
 
 from mbot_sim_bridge.core.geometry import yaw
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.robot_description import expand_xacro
+
+WORKSPACE_SRC = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+# The workspace's packages for $(find ...) in the xacros, also outside the workspace's shell.
+os.environ["ROS_PACKAGE_PATH"] = WORKSPACE_SRC + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
 
 _WORLD = """<?xml version="1.0"?>
 <sdf version="1.6"><world name="default">
@@ -37,22 +42,29 @@ def world_simulation(tmp_path, *models, seed=0) -> Simulation:
     return Simulation(parse_world(path), CORE_PLUGINS, seed=seed)
 
 
-def drive_motion(sim, spawned, plugin, linear, angular, settle, window=1.0):
-    """A drive plugin's command (``set_command(linear, angular)``) held for ``settle`` s, then the robot's mean
-    forward speed in its own frame and its heading change per second over ``window`` s (ground truth)."""
-    plugin.set_command(linear, angular)
-    sim.step(int(settle * 1000))
-    speeds, heading0, start = [], yaw(spawned.robot.root_pose().orientation), sim.sim_time
-    for _ in range(int(window * 20)):
-        sim.step(50)
-        velocity, _ = spawned.robot.root_velocity()
-        heading = yaw(spawned.robot.root_pose().orientation)
-        speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
+def measured_motion(sim, spawned, send_command, settle=1.5, window=1.0):
+    """``send_command()`` every 50 ms of sim time (within any cmd_vel timeout) for ``settle`` s, then ground truth
+    over ``window`` s more: the robot's mean forward speed in its own frame (a chord would shorten arcs) and its
+    heading change per second."""
+    forward_speeds = []
+
+    def run(seconds, record):
+        for _ in range(int(round(seconds / 0.05))):
+            send_command()
+            sim.step(50)
+            if record:
+                velocity, _ = spawned.robot.root_velocity()
+                heading = yaw(spawned.robot.root_pose().orientation)
+                forward_speeds.append(velocity[0] * math.cos(heading) + velocity[1] * math.sin(heading))
+    run(settle, False)
+    start, heading0 = sim.sim_time, yaw(spawned.robot.root_pose().orientation)
+    run(window, True)
     turned = math.remainder(yaw(spawned.robot.root_pose().orientation) - heading0, 2 * math.pi)
-    return sum(speeds) / len(speeds), turned / (sim.sim_time - start)
+    return sum(forward_speeds) / len(forward_speeds), turned / (sim.sim_time - start)
 
 
 def plugin_of(spawned, plugin_class):
+    """The spawned model's plugin of exactly ``plugin_class`` (the first one)."""
     return next(plugin for plugin in spawned.plugins if type(plugin) is plugin_class)
 
 
@@ -99,12 +111,10 @@ ACCEL_NOISE = """<linear_acceleration><z><noise type="gaussian"><type>gaussian</
                 <stddev>0.017</stddev></noise></z></linear_acceleration>"""
 
 
-def course_urdf(name: str) -> str:
-    """A Gazebo xacro of mbot_description expanded by the real xacro ("mbot_with_kinect_gazebo")."""
-    source = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
-    os.environ["ROS_PACKAGE_PATH"] = source + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", "")
-    import xacro_noetic as xacro
-    return xacro.process_file(os.path.join(source, "mbot_description", "urdf", "gazebo", name + ".xacro")).toxml()
+def course_urdf(name: str, **arguments: str) -> str:
+    """A Gazebo xacro of the course's mbot_description ("mbot_with_kinect_gazebo") as robot_description holds it;
+    ``arguments`` are its xacro:arg values."""
+    return expand_xacro(os.path.join(WORKSPACE_SRC, "mbot_description", "urdf", "gazebo", name + ".xacro"), **arguments)
 
 
 def with_imu(urdf: str, accel_noise: bool = False) -> str:

@@ -4,22 +4,22 @@ takes it through a trajectory, the gripper closes on a box, the mimic finger fol
 import os
 
 import pytest
-import xacro_noetic as xacro
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, run_until_ended, simulate, start_controllers
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
     ABORTED, SUCCEEDED, SUCCESSFUL, JointTrajectory, TrajectoryGoal, TrajectoryPoint)
 from mbot_sim_bridge.package_uris import resolve_package_uris
+from mbot_sim_bridge.robot_description import expand_xacro
 
 ARM_XACRO = os.path.join(WORKSPACE_SRC, "arm_description", "urdf", "arm.urdf.xacro")
 CONFIG = os.path.join(WORKSPACE_SRC, "arm_gazebo", "config", "arm_{}_controllers.yaml")
 
 
 def arm(interface):
-    urdf = xacro.process_file(ARM_XACRO, mappings={
-        "transmission_hw_interface": f"hardware_interface/{interface.capitalize()}JointInterface"}).toxml()
+    urdf = expand_xacro(ARM_XACRO,
+                        transmission_hw_interface=f"hardware_interface/{interface.capitalize()}JointInterface")
     assert "package://arm_description/meshes/collision/upper_arm.stl" in urdf
     sim, spawned, plugin = simulate(urdf, load_yaml(CONFIG.format(interface)), "robot",
                                     package_uris=resolve_package_uris, namespace="/")

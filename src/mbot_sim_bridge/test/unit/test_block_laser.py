@@ -1,4 +1,4 @@
-"""libgazebo_ros_block_laser.so (core/block_laser.py): a block laser's points land on a wall at a known place,
+"""libgazebo_ros_block_laser.so (core/sensors/block_laser.py): a block laser's points land on a wall at a known place,
 laid out and placed exactly as upstream's loops place them (mid-angles included); nothing nearer than range_min
 is seen; misses sit at range_max without position noise; noise is seeded."""
 import math
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from sensor_fixtures import box, plugin_of, world_simulation
 
-from mbot_sim_bridge.core.block_laser import BlockLaser
+from mbot_sim_bridge.core.sensors.block_laser import BlockLaser
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 WALL_X = 2.0
 SENSOR_Z = 0.6

@@ -1,5 +1,5 @@
 """apply_body_wrench and clear_body_wrenches (core/body_wrenches.py, Simulation.apply_body_wrench) and
-libgazebo_ros_f3d.so (core/f3d.py): a crate held up by its weight's worth of force hovers and falls once the
+libgazebo_ros_f3d.so (core/sensors/f3d.py): a crate held up by its weight's worth of force hovers and falls once the
 wrench ends or is cleared; f3d reports the applied force on its link and nothing without one; a reference point
 and a reference frame change the wrench as upstream's transform does; bad requests are refused."""
 import math
@@ -9,9 +9,9 @@ from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.body_wrenches import target_wrench
 from mbot_sim_bridge.core.errors import ConfigError, ModelError
-from mbot_sim_bridge.core.f3d import F3D
+from mbot_sim_bridge.core.sensors.f3d import F3D
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 CRATE_MASS, GRAVITY = 4.0, 9.8
 CRATE = f"""<model name="crate"><pose>0 0 1 0 0 0</pose><link name="link">

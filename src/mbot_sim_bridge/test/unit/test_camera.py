@@ -1,4 +1,4 @@
-"""core/camera.py against known geometry: K and P as Gazebo computes them, a coloured box where K says, a wall
+"""core/cameras/camera.py against known geometry: K and P as Gazebo computes them, a coloured box where K says, a wall
 at a known distance in the depth image and the cloud, lazy frames and the renderers' agreement."""
 import math
 import os
@@ -7,13 +7,14 @@ import numpy as np
 import pybullet
 import pytest
 
-from mbot_sim_bridge.core.camera import Camera, CameraConfig, DepthCamera, Intrinsics, camera_intrinsics
-from mbot_sim_bridge.core.image_formats import (convert_image, depth_16uc1, depth_in_range, image_encoding,
-                                                linear_depth, point_cloud)
+from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera, Intrinsics, camera_intrinsics
+from mbot_sim_bridge.core.cameras.render_scene import CameraConfig
+from mbot_sim_bridge.core.cameras.image_formats import (convert_image, depth_16uc1, depth_in_range, image_encoding,
+                                                        linear_depth, point_cloud)
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rotation_matrix
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 from sensor_fixtures import box, course_urdf, plugin_of, world_simulation
 
@@ -190,7 +191,7 @@ def test_frames_follow_the_sensor_rate_and_the_depth_plugin_renders_once_per_fra
 def test_tinyrenderer_is_the_default_and_egl_is_measured_against_it(tmp_path, monkeypatch):
     """TinyRenderer is kept because the EGL renderer does not put things where CameraInfo says; the figures
     show by how much (a box at a known place, 640x480)."""
-    from mbot_sim_bridge.core.render_scene import CameraRenderer
+    from mbot_sim_bridge.core.cameras.render_scene import CameraRenderer
     config = CameraConfig("c", "l", 640, 480, math.radians(60), near=0.05, far=8.0)
     k = camera_intrinsics(config, {})
     centre = (2.0, 0.6, 0.9)  # seen from (0, 0, 0.5) looking along +x

@@ -2,8 +2,8 @@ import math
 
 import pytest
 
-from mbot_sim_bridge.core.diff_drive import (DiffDriveGeometry, EncoderOdometry, WheelSpeedRamp,
-                                             yaw_rotated_velocity)
+from mbot_sim_bridge.core.drives.diff_drive import DiffDriveGeometry, EncoderOdometry, WheelSpeedRamp
+from mbot_sim_bridge.core.drives.twist_drive import yaw_rotated_velocity
 
 SEPARATION, RADIUS = 0.24, 0.032
 

@@ -4,12 +4,12 @@ import os
 
 import pytest
 
-from mbot_sim_bridge.core.diff_drive import DiffDriveGeometry, WheelSpeedRamp
+from mbot_sim_bridge.core.drives.diff_drive import DiffDriveGeometry, WheelSpeedRamp
 from mbot_sim_bridge.core.engine import Engine
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy, rpy, yaw
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.world_bodies import load_world
 
 WHEELS = ("left_wheel_joint", "right_wheel_joint")

@@ -1,14 +1,14 @@
-"""libgazebo_ros_ft_sensor.so (core/ft_sensor.py): a load hanging from a wrist reads its weight and moment within
-2 %, in the child link's frame and with Gazebo's sign (the load's pull on the joint); a load resting on the
+"""libgazebo_ros_ft_sensor.so (core/sensors/ft_sensor.py): a load hanging from a wrist reads its weight and moment
+within 2 %, in the child link's frame and with Gazebo's sign (the load's pull on the joint); a load resting on the
 ground reads nothing; a sensor on a fixed joint is refused as Gazebo's "does not exist"; noise is seeded."""
 import numpy as np
 import pytest
 from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.ft_sensor import FTSensor
+from mbot_sim_bridge.core.sensors.ft_sensor import FTSensor
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, rotation_matrix
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 MASS, GRAVITY = 2.0, np.array([0.0, 0.0, -9.8])
 CENTRE = np.array([0.1, 0.0, -0.2])  # the load's centre of mass in its own (the child's) frame

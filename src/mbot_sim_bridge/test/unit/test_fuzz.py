@@ -21,15 +21,16 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.core.description.model_path import default_model_path
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.robot_description import expand_xacro
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORLDS = os.path.join(HERE, "..", "..", "..", "..", "worlds")
@@ -452,27 +453,26 @@ def test_a_bad_visual_is_left_out(laser_mbot_urdf, simulation, caplog):
 def host_robots(laser_mbot_urdf):
     """Robots that carry between them every emulated plugin but gazebo_ros_control (its one number, controlPeriod,
     is a period() like the hector one's): their descriptions by name."""
+    from plugin_robots import (HOLONOMIC_XACRO, MIMIC_GRIPPER, MIMIC_PLUGIN_BLOCK, SKID_XACRO, STEREO_XACRO,
+                               TRICYCLE_XACRO, VELODYNE_STAND)
     from sensor_fixtures import course_urdf
-    from test_mimic_joint import GRIPPER, PLUGIN as MIMIC_PLUGIN
-    from test_new_plugin_inputs import (HOLONOMIC_XACRO, SENSOR_ROBOTS, SKID_XACRO, STAND, STEREO_XACRO, TRICYCLE_XACRO,
-                                        VLP16_MACRO)
-    import xacro_noetic as xacro
+    from test_new_plugin_inputs import SENSOR_ROBOTS, VLP16_MACRO
     directory = tempfile.mkdtemp(prefix="mbot_fuzz_hosts_")
     stand = os.path.join(directory, "stand.urdf.xacro")
     with open(stand, "w") as stand_file:
-        stand_file.write(STAND.format(macro=VLP16_MACRO, noise=0.008, organize="false"))
+        stand_file.write(VELODYNE_STAND.format(macro=VLP16_MACRO, noise=0.008, organize="false"))
     def small_images(urdf):  # a case renders a dozen frames: at 1280 x 720 they outlast the watchdog
         return re.sub(r"<height>\d+</height>", "<height>48</height>",
                       re.sub(r"<width>\d+</width>", "<width>64</width>", urdf))
     hosts = {"laser mbot": laser_mbot_urdf, "camera mbot": small_images(course_urdf("mbot_with_camera_gazebo")),
              "kinect mbot": small_images(course_urdf("mbot_with_kinect_gazebo")),
-             "planar": xacro.process_file(HOLONOMIC_XACRO, mappings={}).toxml(),
-             "skid": xacro.process_file(SKID_XACRO, mappings={}).toxml(),
-             "tricycle": xacro.process_file(TRICYCLE_XACRO, mappings={}).toxml(),
-             "stereo head": small_images(xacro.process_file(STEREO_XACRO, mappings={"rate": "50"}).toxml()),
+             "planar": expand_xacro(HOLONOMIC_XACRO),
+             "skid": expand_xacro(SKID_XACRO),
+             "tricycle": expand_xacro(TRICYCLE_XACRO),
+             "stereo head": small_images(expand_xacro(STEREO_XACRO, rate="50")),
              # 40 of the VLP-16's 440 columns: at an extreme update_rate it scans every step.
-             "velodyne": xacro.process_file(stand).toxml().replace("<samples>440</samples>", "<samples>40</samples>"),
-             "gripper": GRIPPER.format(mimic="", plugin=MIMIC_PLUGIN.format(extra="")), **SENSOR_ROBOTS}
+             "velodyne": expand_xacro(stand).replace("<samples>440</samples>", "<samples>40</samples>"),
+             "gripper": MIMIC_GRIPPER.format(mimic="", plugin=MIMIC_PLUGIN_BLOCK.format(extra="")), **SENSOR_ROBOTS}
     os.unlink(stand)
     os.rmdir(directory)
     return hosts

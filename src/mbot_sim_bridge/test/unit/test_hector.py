@@ -1,48 +1,21 @@
-"""hector_gazebo_plugins' IMU, GPS and magnetometer (core/hector_imu.py, hector_gps.py, hector_magnetic.py):
+"""hector_gazebo_plugins' IMU, GPS and magnetometer (core/hector/hector_imu.py, hector_gps.py, hector_magnetic.py):
 gravity up at rest, the turn rate, the fix moving north or east by the distance travelled as upstream converts
 it, the field turning with the body, the sensor model."""
 import math
 
 import numpy as np
 import pytest
+from plugin_robots import HECTOR_ROBOT
 from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy
-from mbot_sim_bridge.core.hector_gps import HectorGps, earth_radii
-from mbot_sim_bridge.core.hector_imu import HectorImu
-from mbot_sim_bridge.core.hector_magnetic import HectorMagnetic
-from mbot_sim_bridge.core.hector_sensor_model import SensorModel
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.hector.hector_gps import HectorGps, earth_radii
+from mbot_sim_bridge.core.hector.hector_imu import HectorImu
+from mbot_sim_bridge.core.hector.hector_magnetic import HectorMagnetic
+from mbot_sim_bridge.core.hector.hector_sensor_model import SensorModel
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
-BOX = """<robot name="box">
-  <link name="base_link">
-    <inertial><mass value="10"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.4 0.4 0.2"/></geometry></collision>
-  </link>
-  <link name="imu_link"/>
-  <joint name="imu_joint" type="fixed"><parent link="base_link"/><child link="imu_link"/></joint>
-  <gazebo>
-    <plugin name="imu_controller" filename="libhector_gazebo_ros_imu.so">
-      <updateRate>100</updateRate><bodyName>base_link</bodyName><frameId>imu_link</frameId>
-      <topicName>imu/data</topicName>{imu}
-    </plugin>
-  </gazebo>
-  <gazebo>
-    <plugin name="magnetometer" filename="libhector_gazebo_ros_magnetic.so">
-      <updateRate>50</updateRate><bodyName>base_link</bodyName><topicName>magnetic</topicName>
-      <magnitude>0.5</magnitude><declination>10</declination><inclination>60</inclination>
-      <referenceHeading>{heading}</referenceHeading>
-    </plugin>
-  </gazebo>
-  <gazebo>
-    <plugin name="gps_controller" filename="libhector_gazebo_ros_gps.so">
-      <updateRate>40</updateRate><bodyName>base_link</bodyName><frameId>base_link</frameId>
-      <referenceLatitude>49.9</referenceLatitude><referenceLongitude>8.9</referenceLongitude>
-      <referenceHeading>{heading}</referenceHeading><referenceAltitude>100</referenceAltitude>{gps}
-    </plugin>
-  </gazebo>
-</robot>"""
 
 NOISY_IMU = """
       <accelGaussianNoise>0.05 0.05 0.05</accelGaussianNoise><rateGaussianNoise>0.01 0.01 0.01</rateGaussianNoise>
@@ -52,7 +25,8 @@ NOISY_IMU = """
 
 def spawn_box(tmp_path, heading=0.0, imu="", gps="", pose=Pose((0.0, 0.0, 0.1), (0.0, 0.0, 0.0, 1.0)), seed=0):
     sim = world_simulation(tmp_path, seed=seed)
-    spawned = sim.spawn_robot(parse_robot(BOX.format(heading=heading, imu=imu, gps=gps), "model 'box'"), "box", pose)
+    urdf = HECTOR_ROBOT.format(heading=heading, imu=imu, gps=gps)
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'box'"), "box", pose)
     return sim, spawned
 
 
@@ -132,7 +106,8 @@ def test_the_fix_at_the_spawn_point_is_the_reference(tmp_path):
 def test_the_longitude_stays_a_longitude_at_the_pole(tmp_path):
     sim = world_simulation(tmp_path)
     try:
-        urdf = BOX.format(heading=0.0, imu="", gps="").replace("<referenceLatitude>49.9<", "<referenceLatitude>90<")
+        urdf = HECTOR_ROBOT.format(heading=0.0, imu="", gps="").replace("<referenceLatitude>49.9<",
+                                                                        "<referenceLatitude>90<")
         gps = plugin_of(sim.spawn_robot(parse_robot(urdf, "model 'box'"), "box"), HectorGps)
         latitude, longitude, _ = gps.geodetic((0.0, 1.0, 0.0))
         assert latitude == 90.0 and -180.0 <= longitude < 180.0  # was -8,496,471 degrees a metre from the pole

@@ -1,16 +1,16 @@
-"""core/imu.py and core/p3d.py on the course's mbot with an IMU board on a fixed joint (lumped, as
+"""core/sensors/imu.py and core/sensors/p3d.py on the course's mbot with an IMU board on a fixed joint (lumped, as
 TurtleBot3's imu_link): at rest, turning at 0.5 rad/s, and against the world pose."""
 import logging
 
 import numpy as np
 import pytest
 
-from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose, compose, pose_from_xyz_rpy, rotation_matrix, yaw
-from mbot_sim_bridge.core.imu import ImuModelPlugin, ImuSensor
-from mbot_sim_bridge.core.p3d import P3D
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.sensors.imu import ImuModelPlugin, ImuSensor
+from mbot_sim_bridge.core.sensors.p3d import P3D
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 from sensor_fixtures import course_urdf, plugin_of, with_imu, world_simulation
 

@@ -1,4 +1,4 @@
-"""core/lidar.py: <sensor> parsing and Gazebo-style scans of tiny PyBullet worlds (DIRECT, no master)."""
+"""core/sensors/lidar.py: <sensor> parsing and Gazebo-style scans of tiny PyBullet worlds (DIRECT, no master)."""
 import logging
 import math
 from dataclasses import replace
@@ -10,7 +10,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from mbot_sim_bridge.core.errors import ConfigError, ModelError
 from mbot_sim_bridge.core.geometry import IDENTITY, Pose, compose, pose_from_xyz_rpy
-from mbot_sim_bridge.core.lidar import LaserScanner, RaySensorConfig, parse_ray_sensor
+from mbot_sim_bridge.core.sensors.lidar import LaserScanner, RaySensorConfig, parse_ray_sensor
 from mbot_sim_bridge.core.xml_values import parse_xml
 
 # The tutorial's rplidar block, as lidar_gazebo.xacro expands it.

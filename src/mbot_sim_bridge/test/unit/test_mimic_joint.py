@@ -1,41 +1,17 @@
-"""Mimic joints (core/mimic_joint.py): a gripper finger with a URDF <mimic> follows its leader within 1 mm while the
-leader moves at a gripper's pace, and so does one set up with roboticsgroup's plugin (position or PID effort);
+"""Mimic joints (core/joints/mimic_joint.py): a gripper finger with a URDF <mimic> follows its leader within 1 mm while
+the leader moves at a gripper's pace, and so does one set up with roboticsgroup's plugin (position or PID effort);
 bad mimics are refused with the joint named."""
 import numpy as np
 import pytest
+from plugin_robots import MIMIC_GRIPPER, MIMIC_PLUGIN_BLOCK
 from sensor_fixtures import world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError, ModelError
-from mbot_sim_bridge.core.mimic_joint import MimicJoint
+from mbot_sim_bridge.core.joints.mimic_joint import MimicJoint
 from mbot_sim_bridge.core.parameters import Parameters
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
-GRIPPER = """<robot name="gripper">
-  <link name="palm">
-    <inertial><mass value="100"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.05"/><geometry><box size="0.2 0.3 0.1"/></geometry></collision>
-  </link>
-  <link name="left_finger">
-    <inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.02 0.02 0.08"/></geometry></collision>
-  </link>
-  <link name="right_finger">
-    <inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.02 0.02 0.08"/></geometry></collision>
-  </link>
-  <joint name="left_finger_joint" type="prismatic"><parent link="palm"/><child link="left_finger"/>
-    <origin xyz="0 0.05 0.15"/><axis xyz="0 1 0"/><limit lower="-0.04" upper="0.04" effort="20" velocity="0.2"/>
-  </joint>
-  <joint name="right_finger_joint" type="prismatic"><parent link="palm"/><child link="right_finger"/>
-    <origin xyz="0 -0.05 0.15"/><axis xyz="0 1 0"/><limit lower="-0.04" upper="0.04" effort="20" velocity="0.2"/>
-    {mimic}
-  </joint>
-  {plugin}
-</robot>"""
 URDF_MIMIC = '<mimic joint="left_finger_joint" multiplier="-1" offset="0.002"/>'
-PLUGIN = """<gazebo><plugin name="right_finger_mimic" filename="libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so">
-    <joint>left_finger_joint</joint><mimicJoint>right_finger_joint</mimicJoint><multiplier>-1</multiplier>
-    <offset>0.002</offset>{extra}</plugin></gazebo>"""
 
 
 def pid_gains(gains) -> Parameters:
@@ -46,7 +22,8 @@ def gripper(tmp_path, mimic="", plugin="", parameters=None):
     sim = world_simulation(tmp_path)
     if parameters is not None:
         sim.parameters = parameters
-    spawned = sim.spawn_robot(parse_robot(GRIPPER.format(mimic=mimic, plugin=plugin), "model 'gripper'"), "gripper")
+    urdf = MIMIC_GRIPPER.format(mimic=mimic, plugin=plugin)
+    spawned = sim.spawn_robot(parse_robot(urdf, "model 'gripper'"), "gripper")
     return sim, spawned
 
 
@@ -68,8 +45,8 @@ def worst_follow_error(sim, spawned):
 def test_the_mimic_finger_follows_its_leader_within_a_millimetre(tmp_path, how):
     gains = pid_gains({"p": 2000.0, "i": 0.0, "d": 20.0})
     arguments = {"urdf mimic": dict(mimic=URDF_MIMIC),
-                 "plugin": dict(plugin=PLUGIN.format(extra="")),
-                 "plugin with PID": dict(plugin=PLUGIN.format(extra="<hasPID/>"), parameters=gains)}[how]
+                 "plugin": dict(plugin=MIMIC_PLUGIN_BLOCK.format(extra="")),
+                 "plugin with PID": dict(plugin=MIMIC_PLUGIN_BLOCK.format(extra="<hasPID/>"), parameters=gains)}[how]
     sim, spawned = gripper(tmp_path, **arguments)
     assert [plugin.follower for plugin in spawned.plugins if isinstance(plugin, MimicJoint)] == ["right_finger_joint"]
     assert sim.steps_to_next_event() > 1  # the servo runs between the steps of the loop's batches
@@ -87,12 +64,12 @@ def test_bad_mimics_are_refused_with_the_joint_named(tmp_path):
     with pytest.raises(ConfigError, match="<multiplier>"):
         gripper(tmp_path, mimic='<mimic joint="left_finger_joint" multiplier="1e300"/>')
     with pytest.raises(ConfigError, match="hasPID: no usable gains under /gazebo_ros_control/pid_gains/right_finger"):
-        gripper(tmp_path, plugin=PLUGIN.format(extra="<hasPID/>"))
+        gripper(tmp_path, plugin=MIMIC_PLUGIN_BLOCK.format(extra="<hasPID/>"))
 
 
 def test_pid_effort_is_clamped_to_max_effort(tmp_path):
     gains = pid_gains({"p": 1e6})
-    sim, spawned = gripper(tmp_path, plugin=PLUGIN.format(extra="<hasPID/><maxEffort>0.5</maxEffort>"),
+    sim, spawned = gripper(tmp_path, plugin=MIMIC_PLUGIN_BLOCK.format(extra="<hasPID/><maxEffort>0.5</maxEffort>"),
                            parameters=gains)
     spawned.robot.set_joint_velocity("left_finger_joint", 0.05, 20.0)
     sim.step(20)

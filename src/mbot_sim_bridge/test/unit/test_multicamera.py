@@ -1,28 +1,26 @@
-"""libgazebo_ros_multicamera.so (core/multicamera.py) on mobile_test_robots' stereo head: a world point's disparity
-between the rendered left and right images is fx·baseline/depth within 1 px; the right camera's P carries
+"""libgazebo_ros_multicamera.so (core/cameras/multicamera.py) on mobile_test_robots' stereo head: a world point's
+disparity between the rendered left and right images is fx·baseline/depth within 1 px; the right camera's P carries
 Tx = −fx·hackBaseline and the left's 0; a camera named neither left nor right is said once; no usable camera is
 refused."""
 import math
-import os
 
 import numpy as np
 import pytest
-import xacro_noetic as xacro
+from plugin_robots import STEREO_XACRO
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.multicamera import MultiCamera
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.robot_description import expand_xacro
 
-HEAD = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
-                    "stereo_head.urdf.xacro")
 BASELINE, HEAD_HEIGHT, WIDTH, HFOV = 0.07, 1.0, 320, 1.047
 AT_ORIGIN = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
 def urdf():
-    return xacro.process_file(HEAD, mappings={"width": str(WIDTH)}).toxml()
+    return expand_xacro(STEREO_XACRO, width=str(WIDTH))
 
 
 def red_columns(rgb: np.ndarray) -> np.ndarray:

@@ -8,23 +8,17 @@ import re
 import warnings
 
 import pytest
-import xacro_noetic as xacro
 from sensor_fixtures import box, world_simulation
-from test_bumper import LUMPED, ROBOT as BUMPER_ROBOT
-from test_hector import BOX as HECTOR_ROBOT
-from test_mimic_joint import GRIPPER, PLUGIN as MIMIC_PLUGIN_BLOCK
-from test_multicamera import HEAD as STEREO_XACRO
-from test_planar_move import BASE as HOLONOMIC_XACRO
-from test_range import HECTOR_PLUGIN, RANGE_PLUGIN, ROBOT as SONAR_ROBOT, SONAR
-from test_skid_steer import BASE as SKID_XACRO
-from test_tricycle import TRICYCLE as TRICYCLE_XACRO
-from test_velodyne import ROBOTS, STAND
+from plugin_robots import (BUMPER_LUMPED_COLLISION, BUMPER_ROBOT, HECTOR_ROBOT, HECTOR_SONAR_PLUGIN, HOLONOMIC_XACRO,
+                           MIMIC_GRIPPER, MIMIC_PLUGIN_BLOCK, MOBILE_TEST_ROBOTS, RANGE_PLUGIN, SKID_XACRO, SONAR_ROBOT,
+                           SONAR_SENSOR, STEREO_XACRO, TRICYCLE_XACRO, VELODYNE_STAND)
 
 from mbot_sim_bridge.core.errors import BridgeError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.robot_description import expand_xacro
 
-VLP16_MACRO = os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro"))
+VLP16_MACRO = os.path.abspath(os.path.join(MOBILE_TEST_ROBOTS, "urdf", "VLP-16.urdf.xacro"))
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
 BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-308")
 # For the tags of the later plugins: one of each kind (the parser refuses nan and inf alike; the sign of a huge
@@ -64,8 +58,8 @@ def run(tmp_path, urdf, command=None, steps=300):
 @pytest.fixture(scope="module")
 def velodyne_urdf(tmp_path_factory):
     path = tmp_path_factory.mktemp("velodyne") / "stand.urdf.xacro"
-    path.write_text(STAND.format(macro=VLP16_MACRO, noise=0.008, organize="true"))
-    return xacro.process_file(str(path)).toxml()
+    path.write_text(VELODYNE_STAND.format(macro=VLP16_MACRO, noise=0.008, organize="true"))
+    return expand_xacro(str(path))
 
 
 @pytest.mark.parametrize("text", BAD_TEXTS)
@@ -79,8 +73,8 @@ def test_velodyne_tags(tmp_path, velodyne_urdf, tag, text):
 
 @pytest.fixture(scope="module")
 def drives():
-    return {"planar": xacro.process_file(HOLONOMIC_XACRO, mappings={}).toxml(),
-            "skid": xacro.process_file(SKID_XACRO, mappings={}).toxml()}
+    return {"planar": expand_xacro(HOLONOMIC_XACRO),
+            "skid": expand_xacro(SKID_XACRO)}
 
 
 @pytest.mark.parametrize("value", BAD_VALUES)
@@ -104,10 +98,10 @@ def test_drive_tags(tmp_path, drives, drive, tag, text):
     assert moved is None or moved < 1e-3
 
 
-SONARS = (SONAR.format(name="front", plugin=RANGE_PLUGIN.format(radiation="ultrasound", noise=0))
-          + SONAR.format(name="rear", plugin=HECTOR_PLUGIN.format(noise=0)))
-SENSOR_ROBOTS = {"hector": HECTOR_ROBOT.format(heading=0, imu="", gps=""),
-                 "sonar": SONAR_ROBOT.format(sensors=SONARS), "bumper": BUMPER_ROBOT.format(collision=LUMPED)}
+SONARS = (SONAR_SENSOR.format(name="front", plugin=RANGE_PLUGIN.format(radiation="ultrasound", noise=0))
+          + SONAR_SENSOR.format(name="rear", plugin=HECTOR_SONAR_PLUGIN.format(noise=0)))
+SENSOR_ROBOTS = {"hector": HECTOR_ROBOT.format(heading=0, imu="", gps=""), "sonar": SONAR_ROBOT.format(sensors=SONARS),
+                 "bumper": BUMPER_ROBOT.format(collision=BUMPER_LUMPED_COLLISION)}
 HECTOR_FILES = ("libhector_gazebo_ros_imu.so", "libhector_gazebo_ros_gps.so", "libhector_gazebo_ros_magnetic.so")
 SENSOR_TAGS = [("hector", tag) for tag in ("updateRate", "gaussianNoise", "magnitude", "inclination", "declination",
                                            "referenceHeading", "referenceLatitude", "referenceAltitude", "accelDrift",
@@ -135,7 +129,7 @@ def test_sensor_tags(tmp_path, robot, tag, text):
 
 @pytest.fixture(scope="module")
 def tricycle():
-    return xacro.process_file(TRICYCLE_XACRO, mappings={"odometry_source": "encoder"}).toxml()
+    return expand_xacro(TRICYCLE_XACRO, odometry_source="encoder")
 
 
 @pytest.mark.parametrize("value", BAD_VALUES)
@@ -158,7 +152,7 @@ def test_tricycle_and_block_laser_tags(tmp_path, tricycle, tag, text):
 
 @pytest.fixture(scope="module")
 def stereo_head():
-    return xacro.process_file(STEREO_XACRO, mappings={"rate": "50"}).toxml()
+    return expand_xacro(STEREO_XACRO, rate="50")
 
 
 @pytest.mark.parametrize("text", TAG_TEXTS)
@@ -177,7 +171,7 @@ def test_stereo_head_tags(tmp_path, stereo_head, tag, text):
 def test_mimic_tags(tmp_path, tag, text):
     plugin = MIMIC_PLUGIN_BLOCK.format(extra=f"<hasPID/><{tag}>{text}</{tag}>" if tag == "maxEffort"
                                        else f"<{tag}>{text}</{tag}>")
-    urdf = GRIPPER.format(mimic="", plugin=plugin.replace("<multiplier>-1</multiplier>", "")
+    urdf = MIMIC_GRIPPER.format(mimic="", plugin=plugin.replace("<multiplier>-1</multiplier>", "")
                           .replace("<offset>0.002</offset>", "") if tag in ("multiplier", "offset") else plugin)
     moved = run(tmp_path, urdf)
     assert moved is None or moved < 1e-3
@@ -187,5 +181,5 @@ def test_mimic_tags(tmp_path, tag, text):
 @pytest.mark.parametrize("attribute", ["multiplier", "offset"])
 def test_urdf_mimic_attributes(tmp_path, attribute, text):
     mimic = f'<mimic joint="left_finger_joint" {attribute}="{text}"/>'
-    moved = run(tmp_path, GRIPPER.format(mimic=mimic, plugin=""))
+    moved = run(tmp_path, MIMIC_GRIPPER.format(mimic=mimic, plugin=""))
     assert moved is None or moved < 1e-3

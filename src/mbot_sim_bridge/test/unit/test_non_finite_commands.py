@@ -9,17 +9,17 @@ import pytest
 
 from mbot_sim_bridge.core.errors import BridgeError, ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.ros_control.controller_table import CORE_CONTROLLERS
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import DiffDriveController
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperActionController, GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (JointTrajectory, JointTrajectoryController,
                                                                           TrajectoryPoint)
 
-from conftest import expand_xacro
 from ros_control_fixtures import MBOT_YAML, ROBOTS, expand_xacro_arm, load_yaml, simulate, start_controllers
+from sensor_fixtures import course_urdf
 
 BYSTANDER_TOLERANCE = 1e-3  # m
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
@@ -27,7 +27,7 @@ BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
 
 @pytest.fixture(scope="module")
 def mbot_ros_control_urdf():
-    return expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro")
+    return course_urdf("mbot_ros_control_gazebo")
 
 
 def with_bystander(sim, urdf):

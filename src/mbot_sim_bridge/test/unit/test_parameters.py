@@ -4,8 +4,8 @@ import os
 
 from mbot_sim_bridge.core.parameters import Parameters, absolute_name
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.package_uris import resolve_package_uris
 

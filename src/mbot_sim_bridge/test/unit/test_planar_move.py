@@ -1,24 +1,21 @@
-"""libgazebo_ros_planar_move.so (core/planar_move.py) on mobile_test_robots' holonomic base: the base moves at
+"""libgazebo_ros_planar_move.so (core/drives/planar_move.py) on mobile_test_robots' holonomic base: the base moves at
 the commanded x, y and yaw rate within 1 %, odometry as upstream forms it, cmdTimeout, reset."""
 import math
-import os
 
 import pytest
-import xacro_noetic as xacro
+from plugin_robots import HOLONOMIC_XACRO
 from sensor_fixtures import plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose, yaw
-from mbot_sim_bridge.core.planar_move import PlanarMove
-from mbot_sim_bridge.core.robot_model import parse_robot
-
-BASE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
-                    "holonomic_base.urdf.xacro")
+from mbot_sim_bridge.core.drives.planar_move import PlanarMove
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.robot_description import expand_xacro
 
 
 @pytest.fixture
 def base(tmp_path):
     sim = world_simulation(tmp_path)
-    urdf = xacro.process_file(BASE, mappings={}).toxml()
+    urdf = expand_xacro(HOLONOMIC_XACRO)
     # On the ground: planar move zeroes the vertical velocity every step, so a base spawned above it takes
     # seconds to sink down (in Gazebo too).
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'holonomic_base'"), "holonomic_base",

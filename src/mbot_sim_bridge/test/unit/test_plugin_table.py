@@ -1,5 +1,6 @@
 """The one plugin table: the ROS registry derived from it, both loaded per file name, no copy of the table
 elsewhere, added plugin blocks checked."""
+import ast
 import importlib
 import os
 import pkgutil
@@ -9,15 +10,18 @@ import sys
 
 import pytest
 
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.joints.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.plugin import Plugin
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS, LazyClassTable, filename_of
-from mbot_sim_bridge.core.mimic_joint import MimicJoint
-from mbot_sim_bridge.core.range_sensor import HectorSonar
+from mbot_sim_bridge.core.joints.mimic_joint import MimicJoint
+from mbot_sim_bridge.core.sensors.range_sensor import HectorSonar
 from mbot_sim_bridge.plugins import registry
 from mbot_sim_bridge.plugins.registry import REGISTRY
 
-WORKSPACE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
+UNIT_TESTS = os.path.dirname(os.path.abspath(__file__))
+WORKSPACE = os.path.abspath(os.path.join(UNIT_TESTS, "..", "..", "..", ".."))
+PACKAGE_SOURCE = os.path.join(UNIT_TESTS, "..", "..", "src")
+README = os.path.join(UNIT_TESTS, "..", "..", "README.md")
 # A dictionary entry keyed by a plugin's file name: how a copy of the table would look.
 TABLE_ENTRY = re.compile(r"""["']lib\w+\.so["']\s*:""")
 
@@ -50,6 +54,30 @@ def test_every_plugin_class_of_the_ros_package_is_reachable_through_the_registry
             assert in_use, f"{module.__name__}.{plugin_class.__name__}"
 
 
+def _modules_imported_by_tests():
+    """Test module -> the modules it imports (the checks of this file and of the README's tables left out)."""
+    imported = {}
+    for name in os.listdir(UNIT_TESTS):
+        if name.endswith(".py") and name not in ("test_plugin_table.py", "test_readme.py"):
+            tree = ast.parse(open(os.path.join(UNIT_TESTS, name)).read())
+            imported[name] = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    return imported
+
+
+@pytest.mark.parametrize("filename", sorted(CORE_PLUGINS))
+def test_every_plugin_has_the_five_files_of_the_readme_recipe(filename):
+    """README "Adding a plugin": the core module, the ROS module, the table line, the README's row and tag table,
+    and a unit test of the core class."""
+    core_class = CORE_PLUGINS[filename]  # the table line names a core class that imports
+    core_module = core_class.__module__
+    assert os.path.isfile(os.path.join(PACKAGE_SOURCE, *core_module.split(".")) + ".py")
+    ros_module = registry.home_module(filename)
+    assert os.path.isfile(os.path.join(PACKAGE_SOURCE, *ros_module.split(".")) + ".py"), f"{ros_module} is missing"
+    assert f"`{filename}`" in open(README).read(), f"{filename} is not in the README's supported-plugin table"
+    tests = [name for name, modules in _modules_imported_by_tests().items() if core_module in modules]
+    assert tests, f"no unit test under test/unit imports {core_module}"
+
+
 def test_a_second_file_name_shares_the_first_ones_ros_module():
     assert registry.home_module("libgazebo_ros_gpu_laser.so") == "mbot_sim_bridge.plugins.gazebo_ros_laser"
     assert REGISTRY["libgazebo_ros_gpu_laser.so"] is REGISTRY["libgazebo_ros_laser.so"]
@@ -77,9 +105,10 @@ print(" ".join(sorted(name for name in sys.modules if name.startswith("mbot_sim_
 def test_the_node_imports_only_the_plugins_it_looks_up():
     imported = set(subprocess.run([sys.executable, "-c", IMPORTED_PLUGIN_MODULES], capture_output=True, text=True,
                                   check=True).stdout.split())
-    assert {"mbot_sim_bridge.core.diff_drive", "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"} <= imported
+    assert {"mbot_sim_bridge.core.drives.diff_drive", "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"} <= imported
     # The simulation itself uses the joint state publisher (joints no plugin publishes) and the mimic joint.
-    used = {f"mbot_sim_bridge.core.{module}" for module in ("diff_drive", "joint_states", "mimic_joint")}
+    used = {f"mbot_sim_bridge.core.{module}" for module in ("drives.diff_drive", "joints.joint_states",
+                                                            "joints.mimic_joint")}
     assert not ({core_class.__module__ for core_class in CORE_PLUGINS.values()} - used) & imported
     assert not {module for module in imported if module.startswith("mbot_sim_bridge.plugins.gazebo_ros_")} - {
         "mbot_sim_bridge.plugins.gazebo_ros_diff_drive"}

@@ -1,46 +1,21 @@
-"""Range finders on a ray sensor (core/range_sensor.py): libgazebo_ros_range.so and hector's sonar read a wall
+"""Range finders on a ray sensor (core/sensors/range_sensor.py): libgazebo_ros_range.so and hector's sonar read a wall
 at a known distance within 1 cm, max_range when clear, their field of view and noise as upstream."""
 import numpy as np
 import pytest
+from plugin_robots import HECTOR_SONAR_PLUGIN, RANGE_PLUGIN, SONAR_ROBOT, SONAR_SENSOR
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.range_sensor import INFRARED, ULTRASOUND, HectorSonar, RangeSensor
-from mbot_sim_bridge.core.robot_model import parse_robot
-
-SONAR = """<sensor type="ray" name="{name}">
-  <pose>0 0 0 0 0 0</pose><update_rate>20</update_rate>
-  <ray><scan>
-    <horizontal><samples>5</samples><resolution>1</resolution><min_angle>-0.13</min_angle><max_angle>0.13</max_angle>
-    </horizontal>
-    <vertical><samples>5</samples><resolution>1</resolution><min_angle>-0.05</min_angle><max_angle>0.05</max_angle>
-    </vertical></scan>
-    <range><min>0.02</min><max>4.0</max><resolution>0.01</resolution></range></ray>
-  {plugin}
-</sensor>"""
-RANGE_PLUGIN = """<plugin name="range" filename="libgazebo_ros_range.so">
-  <topicName>sonar_front</topicName><frameName>sonar_link</frameName><radiation>{radiation}</radiation>
-  <fov>0.26</fov><gaussianNoise>{noise}</gaussianNoise></plugin>"""
-HECTOR_PLUGIN = """<plugin name="sonar" filename="libhector_gazebo_ros_sonar.so">
-  <topicName>sonar_rear</topicName><frameId>sonar_link</frameId><gaussianNoise>{noise}</gaussianNoise></plugin>"""
-ROBOT = """<robot name="sonar_bot">
-  <link name="base_link">
-    <inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.1"/><geometry><box size="0.3 0.3 0.2"/></geometry></collision>
-  </link>
-  <link name="sonar_link"/>
-  <joint name="sonar_joint" type="fixed"><parent link="base_link"/><child link="sonar_link"/>
-    <origin xyz="0.15 0 0.3"/></joint>
-  <gazebo reference="sonar_link">{sensors}</gazebo>
-</robot>"""
+from mbot_sim_bridge.core.sensors.range_sensor import INFRARED, ULTRASOUND, HectorSonar, RangeSensor
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 
 def sonar_bot(tmp_path, wall_x=1.15, radiation="ultrasound", noise=0.0, yaw=0.0):
-    sensors = (SONAR.format(name="front", plugin=RANGE_PLUGIN.format(radiation=radiation, noise=noise))
-               + SONAR.format(name="rear", plugin=HECTOR_PLUGIN.format(noise=noise)))
+    sensors = (SONAR_SENSOR.format(name="front", plugin=RANGE_PLUGIN.format(radiation=radiation, noise=noise))
+               + SONAR_SENSOR.format(name="rear", plugin=HECTOR_SONAR_PLUGIN.format(noise=noise)))
     sim = world_simulation(tmp_path, box("wall", (wall_x + 0.05, 0.0, 0.5), (0.1, 4.0, 1.0)))
     quaternion = (0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2))
-    spawned = sim.spawn_robot(parse_robot(ROBOT.format(sensors=sensors), "model 'sonar_bot'"), "sonar_bot",
+    spawned = sim.spawn_robot(parse_robot(SONAR_ROBOT.format(sensors=sensors), "model 'sonar_bot'"), "sonar_bot",
                               Pose((0.0, 0.0, 0.0), quaternion))
     sim.step(100)
     return sim, plugin_of(spawned, RangeSensor), plugin_of(spawned, HectorSonar)

@@ -1,10 +1,11 @@
 import logging
 import os
+from xml.etree import ElementTree
 
 import pytest
 
 from mbot_sim_bridge.core.errors import ModelError
-from mbot_sim_bridge.core.robot_model import parse_robot
+from mbot_sim_bridge.core.description.robot_model import parse_robot
 
 LINK = '<link name="{name}">{inertial}<collision><geometry>{geometry}</geometry></collision></link>'
 INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
@@ -34,10 +35,13 @@ def test_course_mbot_lumps_fixed_links_like_gazebo(mbot_urdf):
     assert [p.get("filename") for p in model.plugins] == ["libgazebo_ros_diff_drive.so"]
 
 
-def test_massless_root_gets_a_negligible_inertial_for_pybullet(mbot_urdf):
+def test_a_massless_root_takes_the_mass_lumped_into_it(mbot_urdf):
     model = parse_robot(mbot_urdf)
     assert not model.links["base_footprint"].has_inertial
-    assert '<mass value="1e-09"' in model.pybullet_urdf
+    root = ElementTree.fromstring(model.pybullet_urdf).find("link[@name='base_footprint']")
+    assert root.find("inertial/mass").get("value") == "20.0"
+    assert float(root.find("inertial/origin").get("xyz").split()[2]) == pytest.approx(0.005 / 2 + 0.01975 * 2)
+    assert not ElementTree.fromstring(model.pybullet_urdf).findall("link[@name='base_link']")
     assert "<gazebo" not in model.pybullet_urdf and "<transmission" not in model.pybullet_urdf
 
 
@@ -141,6 +145,11 @@ def test_a_mesh_that_is_not_a_regular_file_is_refused_unopened(tmp_path):
     os.mkfifo(fifo)
     with pytest.raises(ModelError, match="collision mesh '.*pipe.stl': not a regular file"):
         parse_robot(_mesh_robot(fifo, fifo), "model 'probe'")
+
+
+def test_named_materials_stay_for_the_visuals_that_refer_to_them():
+    urdf = robot('<material name="red"><color rgba="1 0 0 1"/></material>', link("a"))
+    assert '<material name="red"><color rgba="1 0 0 1" /></material>' in parse_robot(urdf).pybullet_urdf
 
 
 @pytest.mark.parametrize("joints, message", [

@@ -1,4 +1,4 @@
-"""core/ros_control/ and core/gazebo_ros_control.py: transmissions, limits, the PID, the diff
+"""core/ros_control/ and core/ros_control/gazebo_ros_control.py: transmissions, limits, the PID, the diff
 drive's odometry and speed limiter, the controller manager's state machine and texts, and the mbot and a
 two-joint arm driven through the controllers in the simulation, with no ROS master."""
 import logging
@@ -18,14 +18,14 @@ from mbot_sim_bridge.core.ros_control.transmissions import parse_transmissions
 from mbot_sim_bridge.core.simulation import MAX_BATCH_SIM_SECONDS
 from mbot_sim_bridge.core.xml_values import parse_xml
 
-from conftest import expand_xacro
-from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, measured_motion,
-                                  recording_batches, simulate, start_controllers, switch, switch_stepping)
+from ros_control_fixtures import (MBOT_YAML, ROBOTS, arm, expand_xacro_arm, load_yaml, recording_batches, simulate,
+                                  start_controllers, switch, switch_stepping)
+from sensor_fixtures import course_urdf, measured_motion
 
 
 @pytest.fixture(scope="module")
 def mbot_ros_control_urdf():
-    return expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro")
+    return course_urdf("mbot_ros_control_gazebo")
 
 
 @pytest.fixture
@@ -94,7 +94,7 @@ def test_the_mbot_wheels_are_velocity_joints_without_limits(mbot):
 
 
 def test_the_mbot_xacro_argument_control_period_sets_how_often_the_controllers_update():
-    urdf = expand_xacro("urdf/gazebo/mbot_ros_control_gazebo.xacro", control_period="0.01")
+    urdf = course_urdf("mbot_ros_control_gazebo", control_period="0.01")
     sim, _, plugin = simulate(urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
     try:
         assert plugin.control_period == pytest.approx(0.01)
@@ -249,20 +249,20 @@ def test_unknown_type_missing_type_and_unknown_joint_fail_with_upstream_texts(mb
 @pytest.mark.parametrize("linear", [0.2, -0.2])
 def test_the_mbot_tracks_linear_speed(mbot, linear):
     sim, spawned, _, controller = mbot
-    speed, _ = measured_motion(sim, spawned, controller, linear, 0.0)
+    speed, _ = measured_motion(sim, spawned, lambda: controller.set_command(linear, 0.0, sim.sim_time))
     assert speed == pytest.approx(linear, rel=0.05)
 
 
 @pytest.mark.parametrize("angular", [0.5, -1.0])
 def test_the_mbot_tracks_yaw_rate_and_turns_left_on_positive(mbot, angular):
     sim, spawned, _, controller = mbot
-    _, yaw_rate = measured_motion(sim, spawned, controller, 0.0, angular)
+    _, yaw_rate = measured_motion(sim, spawned, lambda: controller.set_command(0.0, angular, sim.sim_time))
     assert yaw_rate == pytest.approx(angular, rel=0.05)
 
 
 def test_cmd_vel_timeout_stops_the_mbot(mbot):
     sim, spawned, _, controller = mbot
-    measured_motion(sim, spawned, controller, 0.3, 0.0)
+    measured_motion(sim, spawned, lambda: controller.set_command(0.3, 0.0, sim.sim_time))
     sim.step(int(controller.cmd_vel_timeout * 1000) + 500)  # no command for timeout + 0.5 s
     linear, _ = spawned.robot.root_velocity()
     assert math.hypot(linear[0], linear[1]) < 0.005
@@ -323,7 +323,8 @@ def test_effort_limits_saturate_the_pid_output(caplog):
 
 def test_e_stop_stops_the_wheels_and_restarts_the_controllers_on_release(mbot):
     sim, spawned, plugin, controller = mbot
-    measured_motion(sim, spawned, controller, 0.3, 0.0, settle=1.0, window=0.1)
+    measured_motion(sim, spawned, lambda: controller.set_command(0.3, 0.0, sim.sim_time), settle=1.0,
+                    window=0.1)
     plugin.e_stop = True
     for _ in range(20):
         controller.set_command(0.3, 0.0, sim.sim_time)
@@ -331,7 +332,8 @@ def test_e_stop_stops_the_wheels_and_restarts_the_controllers_on_release(mbot):
     linear, _ = spawned.robot.root_velocity()
     assert math.hypot(linear[0], linear[1]) < 0.005
     plugin.e_stop = False
-    speed, _ = measured_motion(sim, spawned, controller, 0.3, 0.0, settle=1.0, window=0.5)
+    speed, _ = measured_motion(sim, spawned, lambda: controller.set_command(0.3, 0.0, sim.sim_time), settle=1.0,
+                               window=0.5)
     assert speed == pytest.approx(0.3, rel=0.05)
 
 

@@ -2,8 +2,8 @@ import pytest
 
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 
 BOX = """<sdf version="1.6"><model name="crate"><static>true</static><pose>1 0 0.25 0 0 0</pose>
   <link name="link"><collision name="c"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision>

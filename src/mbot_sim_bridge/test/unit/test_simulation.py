@@ -8,16 +8,17 @@ import sys
 
 import numpy as np
 import pytest
+from sensor_fixtures import plugin_of
 
 from mbot_sim_bridge.core.clock import UpdateTimer
-from mbot_sim_bridge.core.diff_drive import DiffDrive
+from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import ConfigError, ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
-from mbot_sim_bridge.core.joint_states import JointStatePublisher
-from mbot_sim_bridge.core.lidar import RaySensor
+from mbot_sim_bridge.core.joints.joint_states import JointStatePublisher
+from mbot_sim_bridge.core.sensors.lidar import RaySensor
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_world import parse_world
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 
 WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds")
@@ -25,10 +26,6 @@ WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds
 
 def simulation(world="empty.world", seed=0):
     return Simulation(parse_world(os.path.join(WORLDS, world)), CORE_PLUGINS, seed=seed)
-
-
-def plugin_of(spawned, plugin_class):
-    return next(plugin for plugin in spawned.plugins if isinstance(plugin, plugin_class))
 
 
 def test_spawn_command_step_and_read_odometry(mbot_urdf):

@@ -1,23 +1,20 @@
-"""libgazebo_ros_skid_steer_drive.so (core/skid_steer_drive.py) on mobile_test_robots' skid-steer base: straight
+"""libgazebo_ros_skid_steer_drive.so (core/drives/skid_steer_drive.py) on mobile_test_robots' skid-steer base: straight
 lines within 5 %, turns the commanded way, ground-truth odometry, bad joints refused, NaN ignored, reset."""
 import math
-import os
 import re
 
 import pytest
-import xacro_noetic as xacro
-from sensor_fixtures import drive_motion, plugin_of, world_simulation
+from plugin_robots import SKID_XACRO
+from sensor_fixtures import measured_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.skid_steer_drive import SkidSteerDrive
-
-BASE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
-                    "skid_steer_base.urdf.xacro")
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.drives.skid_steer_drive import SkidSteerDrive
+from mbot_sim_bridge.robot_description import expand_xacro
 
 
 def urdf():
-    return xacro.process_file(BASE, mappings={}).toxml()
+    return expand_xacro(SKID_XACRO)
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +28,8 @@ def base(tmp_path_factory):
 
 @pytest.mark.parametrize("linear", [0.5, -0.3])
 def test_straight_lines_within_5_percent(base, linear):
-    speed, yaw_rate = drive_motion(*base, linear, 0.0, settle=1.0)
+    sim, spawned, plugin = base
+    speed, yaw_rate = measured_motion(sim, spawned, lambda: plugin.set_command(linear, 0.0), settle=1.0)
     print(f"figure: skid steer plugin: {linear} m/s commanded -> {speed:.4f} m/s")
     assert speed == pytest.approx(linear, rel=0.05)
     assert abs(yaw_rate) < 0.01
@@ -40,7 +38,8 @@ def test_straight_lines_within_5_percent(base, linear):
 @pytest.mark.parametrize("angular", [0.8, -0.8])
 def test_turns_in_place_the_commanded_way(base, angular):
     """Skid steering turns by sliding the wheels sideways: the rate depends on friction (README)."""
-    speed, yaw_rate = drive_motion(*base, 0.0, angular, settle=1.0)
+    sim, spawned, plugin = base
+    speed, yaw_rate = measured_motion(sim, spawned, lambda: plugin.set_command(0.0, angular), settle=1.0)
     print(f"figure: skid steer plugin: {angular} rad/s commanded -> {yaw_rate:.3f} rad/s")
     assert yaw_rate * angular > 0 and abs(yaw_rate) > 0.3 * abs(angular)
     assert abs(speed) < 0.02
@@ -48,7 +47,7 @@ def test_turns_in_place_the_commanded_way(base, angular):
 
 def test_odometry_is_the_ground_truth_and_nan_is_ignored_and_reset_stops(base):
     sim, spawned, plugin = base
-    drive_motion(sim, spawned, plugin, 0.4, 0.0, settle=0.5, window=0.2)
+    measured_motion(sim, spawned, lambda: plugin.set_command(0.4, 0.0), settle=0.5, window=0.2)
     sim.step(10)  # one update at 100 Hz
     assert plugin.latest.pose.position == pytest.approx(spawned.robot.root_pose().position, abs=0.01)
     assert plugin.latest.linear[0] == pytest.approx(0.4, rel=0.05)

@@ -1,27 +1,25 @@
-"""libgazebo_ros_tricycle_drive.so (core/tricycle_drive.py) on mobile_test_robots' tricycle: cmd_vel's linear.x is the
-front wheel's speed and angular.z the steering angle, as upstream reads them; in steady state the base moves as a
+"""libgazebo_ros_tricycle_drive.so (core/drives/tricycle_drive.py) on mobile_test_robots' tricycle: cmd_vel's linear.x
+is the front wheel's speed and angular.z the steering angle, as upstream reads them; in steady state the base moves as a
 tricycle's kinematics say within 5 %, both ways round, forwards and backwards; encoder odometry keeps the
 distance within 5 % (and upstream's heading sign); bad joints are refused, NaN ignored, reset stops it."""
 import math
-import os
 
 import pytest
-import xacro_noetic as xacro
-from sensor_fixtures import drive_motion, plugin_of, world_simulation
+from plugin_robots import TRICYCLE_XACRO
+from sensor_fixtures import measured_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.tricycle_drive import TricycleDrive
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.drives.tricycle_drive import TricycleDrive
+from mbot_sim_bridge.robot_description import expand_xacro
 
-TRICYCLE = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots", "urdf",
-                        "tricycle.urdf.xacro")
 WHEELBASE = 0.5
 ON_ITS_WHEELS = pose_from_xyz_rpy((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 def urdf(odometry_source="world"):
-    return xacro.process_file(TRICYCLE, mappings={"odometry_source": odometry_source}).toxml()
+    return expand_xacro(TRICYCLE_XACRO, odometry_source=odometry_source)
 
 
 def spawn(tmp_path, text):
@@ -41,7 +39,7 @@ def tricycle(tmp_path_factory):
 @pytest.mark.parametrize("speed, angle", [(0.5, 0.0), (-0.3, 0.0), (0.5, 0.4), (0.5, -0.4), (-0.3, 0.4)])
 def test_the_base_moves_as_a_tricycle_within_5_percent(tricycle, speed, angle):
     sim, spawned, plugin = tricycle
-    forward, yaw_rate = drive_motion(sim, spawned, plugin, speed, angle, settle=1.5)
+    forward, yaw_rate = measured_motion(sim, spawned, lambda: plugin.set_command(speed, angle))
     # The front wheel rolls at `speed` along its own heading; the rear axle follows.
     expected_forward, expected_yaw_rate = speed * math.cos(angle), speed * math.sin(angle) / WHEELBASE
     (steering, _, _), = spawned.robot.joint_state(["front_steering_joint"])
@@ -54,7 +52,7 @@ def test_the_base_moves_as_a_tricycle_within_5_percent(tricycle, speed, angle):
 
 def test_world_odometry_is_the_ground_truth(tricycle):
     sim, spawned, plugin = tricycle
-    drive_motion(sim, spawned, plugin, 0.4, 0.2, settle=1.0, window=0.2)
+    measured_motion(sim, spawned, lambda: plugin.set_command(0.4, 0.2), settle=1.0, window=0.2)
     sim.step(20)  # one update at 50 Hz
     odometry = plugin.latest
     assert odometry.pose.position == pytest.approx(spawned.robot.root_pose().position, abs=0.01)

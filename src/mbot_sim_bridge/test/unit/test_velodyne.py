@@ -1,4 +1,4 @@
-"""Velodyne's lidar plugins (core/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
+"""Velodyne's lidar plugins (core/sensors/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
 in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
 import math
 import os
@@ -6,26 +6,15 @@ import re
 
 import numpy as np
 import pytest
-import xacro_noetic as xacro
+from plugin_robots import MOBILE_TEST_ROBOTS, VELODYNE_STAND
 from sensor_fixtures import box, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.velodyne_laser import VelodyneLaser
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.sensors.velodyne_laser import VelodyneLaser
+from mbot_sim_bridge.robot_description import expand_xacro
 
-ROBOTS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "mobile_test_robots")
-STAND = """<robot name="stand" xmlns:xacro="http://www.ros.org/wiki/xacro">
-  <xacro:include filename="{macro}"/>
-  <link name="base_link">
-    <inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.25"/><geometry><box size="0.3 0.3 0.5"/></geometry></collision>
-  </link>
-  <xacro:VLP-16 parent="base_link" name="velodyne" topic="velodyne_points" hz="10" samples="440" noise="{noise}"
-                organize_cloud="{organize}">
-    <origin xyz="0 0 0.5" rpy="0 0 0"/>
-  </xacro:VLP-16>
-</robot>"""
 WALL_X = 3.0
 # The scan frame: 0.5 m mount plus 37.7 mm.
 SENSOR_Z = 0.5377
@@ -33,10 +22,10 @@ SENSOR_Z = 0.5377
 
 def velodyne(tmp_path, noise=0.0, organize=False):
     path = tmp_path / "stand.urdf.xacro"
-    path.write_text(STAND.format(macro=os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro")),
-                                 noise=noise, organize=str(organize).lower()))
+    macro = os.path.abspath(os.path.join(MOBILE_TEST_ROBOTS, "urdf", "VLP-16.urdf.xacro"))
+    path.write_text(VELODYNE_STAND.format(macro=macro, noise=noise, organize=str(organize).lower()))
     sim = world_simulation(tmp_path, box("wall", (WALL_X + 0.05, 0.0, 1.5), (0.1, 20.0, 3.0)))
-    urdf = xacro.process_file(str(path)).toxml()
+    urdf = expand_xacro(str(path))
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand", Pose((0.0, 0.0, 0.0), (0, 0, 0, 1)))
     sim.step(10)
     return sim, plugin_of(spawned, VelodyneLaser)
@@ -49,9 +38,9 @@ def velodyne(tmp_path, noise=0.0, organize=False):
 ])
 def test_a_range_window_that_keeps_nothing_is_refused(tmp_path, tags, message):
     path = tmp_path / "stand.urdf.xacro"
-    path.write_text(STAND.format(macro=os.path.abspath(os.path.join(ROBOTS, "urdf", "VLP-16.urdf.xacro")),
-                                 noise=0.0, organize="false"))
-    urdf = xacro.process_file(str(path)).toxml()
+    macro = os.path.abspath(os.path.join(MOBILE_TEST_ROBOTS, "urdf", "VLP-16.urdf.xacro"))
+    path.write_text(VELODYNE_STAND.format(macro=macro, noise=0.0, organize="false"))
+    urdf = expand_xacro(str(path))
     for tag, text in tags.items():
         urdf, replaced = re.subn(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", urdf)
         assert replaced == 1

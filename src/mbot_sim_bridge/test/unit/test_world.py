@@ -11,11 +11,11 @@ import pytest
 
 from mbot_sim_bridge.core.errors import WorldError
 from mbot_sim_bridge.core.geometry import yaw
-from mbot_sim_bridge.core.mesh import load_mesh
-from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_sim_bridge.core.world_description import PhysicsConfig
+from mbot_sim_bridge.core.description.mesh import load_mesh
+from mbot_sim_bridge.core.description.sdf_world import parse_world
+from mbot_sim_bridge.core.description.world_description import PhysicsConfig
 from mbot_sim_bridge.core.world_bodies import load_world, world_lateral_friction
-from mbot_sim_bridge.core.model_path import default_model_path
+from mbot_sim_bridge.core.description.model_path import default_model_path
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TEST_WORLDS = os.path.join(HERE, "..", "worlds")

@@ -1,4 +1,4 @@
-"""core/world_writer.py: a running world saved as SDF loads back to the same poses (no ROS master)."""
+"""core/description/world_writer.py: a running world saved as SDF loads back to the same poses (no ROS master)."""
 import math
 import os
 import stat
@@ -9,13 +9,13 @@ import pytest
 
 from mbot_sim_bridge.core.errors import WorldError
 from mbot_sim_bridge.core.geometry import Pose, compose, inverse, pose_from_xyz_rpy
-from mbot_sim_bridge.core.model_path import default_model_path
-from mbot_sim_bridge.core.robot_model import parse_robot
-from mbot_sim_bridge.core.sdf_spawn import spawn_world_xml
-from mbot_sim_bridge.core.sdf_world import parse_world
-from mbot_sim_bridge.core.world_description import PhysicsConfig
+from mbot_sim_bridge.core.description.model_path import default_model_path
+from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
+from mbot_sim_bridge.core.description.world_description import PhysicsConfig
 from mbot_sim_bridge.core.simulation import Simulation
-from mbot_sim_bridge.core.world_writer import pose_text, take_snapshot, world_sdf, write_world_file
+from mbot_sim_bridge.core.description.world_writer import pose_text, take_snapshot, world_sdf, write_world_file
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO_WORLDS = os.path.abspath(os.path.join(HERE, "..", "..", "..", "..", "worlds"))
@@ -107,11 +107,12 @@ def test_includes_stay_includes_with_name_and_pose_and_the_rest_is_copied(tmp_pa
 
 def test_physics_settings_are_written(tmp_path):
     world = parse_world(os.path.join(REPO_WORLDS, "empty.world"))
-    world = type(world)(world.name, world.path, PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0)), world.models,
-                        world.others)
+    physics = PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0), erp=0.4, contact_max_correcting_vel=2.0,
+                            contact_surface_layer=0.002)
+    world = type(world)(world.name, world.path, physics, world.models, world.others)
     simulation = Simulation(world, {})
     _, path, reloaded = save_and_reload(simulation, world, tmp_path)
-    assert reloaded.physics == PhysicsConfig(0.002, 0.5, 250.0, (0.0, 0.0, -5.0))
+    assert reloaded.physics == physics
     check_sdf_1_6_structure(path)
     simulation.close()
 

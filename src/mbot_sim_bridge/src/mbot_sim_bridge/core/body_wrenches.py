@@ -13,17 +13,20 @@ that frame's orientation relative to the link, and the torque gains (frame posit
 force. The result is applied in the world frame, so a wrench given in the link's own frame acts along the world
 axes (upstream's "FIXME map is really wrong").
 """
+import math
 import sys
 import threading
-from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .geometry import Pose, inverse, compose, rotate
+from .errors import ModelError
+from .geometry import Pose, Vector, inverse, compose, rotate
 
-Vector = Tuple[float, float, float]
 ZERO = (0.0, 0.0, 0.0)
 WORLD_FRAMES = ("", "world", "map", "/map")
+# apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
+MAX_WRENCH = 1e6
 
 
 class WrenchJob(NamedTuple):
@@ -52,6 +55,30 @@ def target_wrench(force: Sequence[float], torque: Sequence[float], reference_poi
     force = np.asarray(rotate(relative.orientation, force))
     torque = np.asarray(rotate(relative.orientation, torque)) + np.cross(relative.position, force)
     return tuple(force.tolist()), tuple(torque.tolist())
+
+
+def requested_job(body: str, reference_frame: str, reference_point: Sequence[float], force: Sequence[float],
+                  torque: Sequence[float], start: float, duration: float, link_names: Callable[[str], List[str]],
+                  link_pose: Callable[[str, str], Pose], entity_pose: Callable[[str], Optional[Pose]]) -> WrenchJob:
+    """An apply_body_wrench request as a job on link ``body`` ("model::link"), checked as gazebo_ros checks it: an
+    unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite or
+    beyond MAX_WRENCH (the physics would turn the model's state NaN). The simulation's ``link_names(model)``,
+    ``link_pose(model, link)`` and ``entity_pose(name)`` (None: no such entity) say what exists where."""
+    model, _, link = body.partition("::")
+    if link not in link_names(model):
+        known = ", ".join(f"{model}::{name}" for name in link_names(model)) or "no such model"
+        raise ModelError(f"ApplyBodyWrench: body does not exist: '{body}' ({known})")
+    values = [*reference_point, *force, *torque]
+    if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
+        raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
+                         f"at most {MAX_WRENCH:g} in size; got {values}")
+    frame_pose = None
+    if reference_frame not in WORLD_FRAMES:
+        frame_pose = entity_pose(reference_frame)
+        if frame_pose is None:
+            raise ModelError(f"ApplyBodyWrench: reference_frame '{reference_frame}' is not a valid entity name")
+    force, torque = target_wrench(force, torque, reference_point, link_pose(model, link), frame_pose)
+    return WrenchJob(model, link, force, torque, start, duration)
 
 
 class BodyWrenches:

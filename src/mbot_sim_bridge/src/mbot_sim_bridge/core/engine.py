@@ -16,13 +16,14 @@ import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
 from .errors import ModelError
-from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotation_matrices,
-                       rotation_matrix)
+from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotate,
+                       rotation_matrices, rotation_matrix)
 from .log import c_stdout_to, get_logger, warn_once
-from .robot_model import RobotModel
-from .world_description import PhysicsConfig
+from .description.mesh import with_pybullet_readable_meshes
+from .description.robot_model import RobotModel
+from .description.world_description import PhysicsConfig
+from .wheel_contact import WheelContacts, wheel
 from .world_bodies import LoadedWorld
-from .xml_values import check_range, parse_float
 
 _logger = get_logger(__name__)
 
@@ -30,8 +31,22 @@ _logger = get_logger(__name__)
 # so poses and velocities given from outside are refused past them.
 MAX_POSITION = 1.0e5  # m
 MAX_SPEED = 1.0e4  # m/s and rad/s
-# Gazebo's default friction coefficient for a surface that sets none (ODE mu = mu2 = 1).
-DEFAULT_MU = 1.0
+# SDF's <surface><contact><ode><max_vel> when a link sets none (URDF <maxVel>): with the world's
+# contact_max_correcting_vel, the most velocity Gazebo's ODE leaves a link with from undoing a penetration.
+DEFAULT_SURFACE_MAX_VEL = 0.01  # m/s
+# PyBullet's contact slop and error reduction, kept: its contacts leave this depth uncorrected (ODE's surface
+# layer, 1 mm by default, is not applied: see _configure) and undo this fraction of the rest per step.
+CONTACT_SLOP = 1.0e-5  # m
+CONTACT_ERP = 0.08
+# A placed body settles until it has gone this long without a contact deep enough for Bullet to undo it faster
+# than the cap (at least PENETRATION_TOLERANCE beyond the slop); one still that deep after SETTLING_WARNING is said
+# once (it stays watched).
+SETTLED_AFTER = 0.01  # s of sim time
+SETTLING_WARNING = 1.0  # s of sim time
+PENETRATION_TOLERANCE = 1.0e-5  # m
+# A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
+# stay finite below it.
+MAX_WHEEL_MU = 1.0e3
 # PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
 # every query fails ("GetBasePositionAndOrientation failed").
 MAX_BODY_LINKS = 128
@@ -115,15 +130,6 @@ def check_model_name(what: str, name: str):
                          f"(which separates a model's links) or '/'; nothing was spawned")
 
 
-def _friction(text: str, model: str, link: str) -> float:
-    try:
-        value = parse_float(text)
-        check_range(value, minimum=0.0)
-    except ValueError as error:
-        raise ModelError(f"model '{model}': <gazebo reference='{link}'> friction '{text}': {error}") from None
-    return value
-
-
 class RecordedLinkStates(NamedTuple):
     """A link frame at consecutive steps, one row each, in the world."""
     orientations: np.ndarray  # (N, 4) xyzw
@@ -146,10 +152,16 @@ class SpawnedRobot:
         self.driven_joints: Tuple[str, ...] = ()
         self.loads = 1  # a new body (respawn) has every motor off, whatever a plugin set on the old one
         self.link_index: Dict[str, int] = {model.root: -1}
+        # Bullet links of lumped links kept for their own surface: not links Gazebo has, so not in link_index.
+        self.surface_link_index: Dict[str, int] = {}
         self.joint_index: Dict[str, int] = {}
         for index in range(client.getNumJoints(body)):
             info = client.getJointInfo(body, index)
-            self.link_index[info[12].decode()] = index
+            link_name = info[12].decode()
+            if link_name in model.separate_surfaces:
+                self.surface_link_index[link_name] = index
+            else:
+                self.link_index[link_name] = index
             self.joint_index[info[1].decode()] = index
         self.root_from_com = root_from_com(client, body)
         self._frames_from_com: Dict[str, Pose] = {}  # a base-lumped link's frame seen from the centre of mass
@@ -172,6 +184,11 @@ class SpawnedRobot:
             state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
             frame = Pose(tuple(state[4]), tuple(state[5]))
         return compose(frame, offset) if offset != IDENTITY else frame
+
+    def bullet_links(self, link_name: str) -> List[int]:
+        """The Bullet links holding the collisions of a simulated link: its own and its separate surfaces'."""
+        return [self.link_index[link_name]] + [index for name, index in self.surface_link_index.items()
+                                               if self.model.lumped_into[name][0] == link_name]
 
     def joint_state(self, joint_names: Sequence[str]) -> List[Tuple[float, float, float]]:
         """(position, velocity, applied effort) per named joint."""
@@ -257,6 +274,11 @@ class SpawnedRobot:
         self.client.setJointMotorControl2(self.body, self.joint_index[joint_name], pybullet.TORQUE_CONTROL,
                                           force=effort)
 
+    def set_joint_positions(self, positions: Dict[str, float]):
+        """Joints put at positions, at rest (set_model_configuration), outside the physics."""
+        for joint_name, position in positions.items():
+            self.client.resetJointState(self.body, self.joint_index[joint_name], position, 0.0)
+
     def release_joint(self, joint_name: str):
         """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
         self.set_joint_velocity(joint_name, 0.0, 0.0)
@@ -276,6 +298,11 @@ class Engine:
         self._initial: Dict[int, _InitialState] = {}
         # Per body, the model frame seen from the centre of mass where PyBullet places a base.
         self._root_from_com: Dict[int, Pose] = {}
+        # Bodies placed where they may penetrate others (spawn, set_model_state, reset): body -> [steps settling,
+        # steps since its last deep contact]; see _bound_correction.
+        self._settling: Dict[int, List[int]] = {}
+        self._wheels: Dict[int, WheelContacts] = {}  # per body, the friction of its wheels (wheel_contact)
+        self._before_step: List[Callable[[], None]] = []
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -285,6 +312,11 @@ class Engine:
         # friction made four-wheel skid-steer bases turn in place by fits and starts (yaw rate 0.08 to 0.8 rad/s
         # for a steady 0.8 command).
         self.client.setPhysicsEngineParameter(deterministicOverlappingPairs=1, enableConeFriction=0)
+        # The world's <ode><constraints> erp is ODE's error reduction for joints, Bullet's erp (the SDF default is
+        # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
+        # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
+        # into what it touches and moved the skid-steer turn figures by 1 %.
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -301,17 +333,33 @@ class Engine:
         self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
+        self._settling.clear()
+        self._wheels.clear()
+        self._before_step = []
 
     @property
     def sim_time(self) -> float:
         return self.steps * self.physics.max_step_size
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
-        """``count`` physics steps; each of ``after_each`` (recorders of per-step state, then the plugins that act
-        on every step) is called after every one, with ``sim_time`` already that step's."""
+        """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of
+        ``after_each`` (recorders of per-step state, then the plugins that act on every step) is called after
+        every one, with ``sim_time`` already that step's."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
-        if after_each:
+        before = self._before_step
+        while self._settling and count > 0:
+            for call in before:
+                call()
+            step()
+            self.steps += 1
+            count -= 1
+            self._bound_correction()
+            for call in after_each:
+                call()
+        if after_each or before:
             for _ in range(count):
+                for call in before:
+                    call()
                 step()
                 self.steps += 1
                 for call in after_each:
@@ -334,6 +382,7 @@ class Engine:
                                           for link, shape in zip(links, shapes)}
             self._root_from_com[body] = inverse(world.inertial_frames[name])
             self._remember_initial_state(body)
+            self._settle(body)
 
     def model_names(self) -> List[str]:
         return list(self.world_bodies) + list(self.robots)
@@ -368,12 +417,15 @@ class Engine:
         for joint_name in robot.movable_joints:
             robot.release_joint(joint_name)
         self.robots[robot.name] = robot
-        # A link holding several collisions is named by its first: Bullet reports contacts per link.
-        self.collision_names[robot.body] = {robot.link_index[link]: f"{robot.name}::{link}::{names[0]}"
-                                            for link, names in robot.model.collision_names().items()
-                                            if names and link in robot.link_index}
+        # A link holding several collisions is named by its first: Bullet reports contacts per link. A separate
+        # surface's Bullet link is named by its own, which Gazebo holds in the link it is lumped into.
+        indices = {**robot.link_index, **robot.surface_link_index}
+        self.collision_names[robot.body] = {
+            indices[link]: f"{robot.name}::{robot.model.lumped_into[link][0]}::{names[0]}"
+            for link, names in robot.model.bullet_collision_names().items() if names and link in indices}
         self._root_from_com[robot.body] = robot.root_from_com
         self._remember_initial_state(robot.body)
+        self._settle(robot.body, anchored=robot.model.anchored)
 
     def remove(self, name: str):
         if name in self.robots:
@@ -385,7 +437,9 @@ class Engine:
             raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
         self._root_from_com.pop(body, None)
+        self._settling.pop(body, None)
         self.collision_names.pop(body, None)
+        self._set_wheels(body, None)
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -419,11 +473,88 @@ class Engine:
         com = compose(pose, inverse(self._root_from_com[body]))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)
+        self._settle(body)
+
+    def set_joint_positions(self, robot: SpawnedRobot, positions: Dict[str, float]):
+        """Joints of a robot put at positions, at rest (set_model_configuration)."""
+        robot.set_joint_positions(positions)
+        self._settle(robot.body, anchored=robot.model.anchored)
 
     def reset_world(self):
         """Every model back to its spawn pose and joint positions, at rest (Gazebo's reset_world)."""
         for body in self._initial:
             self._restore_initial_state(body)
+            self._settle(body)
+
+    def _settle(self, body: int, anchored: bool = False):
+        """Watch a body just placed (see _bound_correction); bodies that cannot move need no watching."""
+        if not anchored and self.client.getDynamicsInfo(body, -1)[0] > 0.0:
+            self._settling[body] = [0, 0]
+
+    def _bound_correction(self):
+        """Penetration undone as Gazebo's ODE undoes it: the contacts move a body out at their error reduction
+        rate, but leave it with a separating velocity of at most min(link max_vel, contact_max_correcting_vel)
+        (ODE solves the correction apart from the velocity). Bullet's multibody contacts turn the whole correction
+        into velocity (its split impulse is for rigid bodies only), which threw a robot spawned 13 cm into the
+        ground 4.6 m up. So after each step, where a contact of a placed body is deep enough for Bullet to undo it
+        faster than the cap (resting contacts are not), the velocities of the bodies in it are scaled so that they
+        move apart there at no more than the cap (the whole relative speed, not only its normal part: through
+        friction and rotation the correction also pushes sideways, which carried a box wedged between two walls
+        off at 1 m/s).
+
+        Bodies are watched from their placement until they have been clear of deep contacts for SETTLED_AFTER:
+        contacts that arise in motion keep Bullet's behaviour (and its cost), as before. A wedged body stays
+        watched, as ODE caps its contacts for ever."""
+        client, physics = self.client, self.physics
+        cap = min(physics.contact_max_correcting_vel, DEFAULT_SURFACE_MAX_VEL)
+        deep = CONTACT_SLOP + max(PENETRATION_TOLERANCE, cap * physics.max_step_size / CONTACT_ERP)
+        settled_after = max(1, round(SETTLED_AFTER / physics.max_step_size))
+        scales: Dict[int, float] = {}
+        for body, counts in list(self._settling.items()):
+            counts[0] += 1
+            counts[1] += 1
+            for point in client.getContactPoints(bodyA=body):
+                if -point[8] <= deep:
+                    continue
+                counts[1] = 0
+                body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
+                velocity_a = self._point_velocity(body_a, link_a, on_a)
+                velocity_b = self._point_velocity(body_b, link_b, on_b)
+                speed = math.dist(velocity_a, velocity_b)
+                if speed > cap:
+                    for moved in (body_a, body_b):
+                        scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            if counts[1] >= settled_after:
+                del self._settling[body]
+            elif counts[0] == round(SETTLING_WARNING / physics.max_step_size):
+                warn_once(_logger, f"model '{self._name_of(body)}' is still inside another model "
+                                   f"{SETTLING_WARNING:g} s after it was placed (wedged?); it is pushed out at "
+                                   f"{cap:g} m/s at most")
+        if scales:
+            self._scale_velocities(scales)
+
+    def _scale_velocities(self, scales: Dict[int, float]):
+        """Each body's base twist and joint velocities times its scale: a wheel pushed out of a wall spins with the
+        correction too, and would drive the robot away."""
+        client = self.client
+        joints = {robot.body: [robot.joint_index[name] for name in robot.movable_joints]
+                  for robot in self.robots.values()}
+        for body, scale in scales.items():
+            linear, angular = client.getBaseVelocity(body)
+            client.resetBaseVelocity(body, [scale * value for value in linear], [scale * value for value in angular])
+            indices = joints.get(body)
+            if indices:
+                for index, (position, velocity, *_) in zip(indices, client.getJointStates(body, indices)):
+                    client.resetJointState(body, index, position, scale * velocity)
+
+    def _point_velocity(self, body: int, link: int, point) -> Tuple[float, ...]:
+        if link == -1:
+            return frame_velocity(self.client, body, point)[0]
+        state = self.client.getLinkState(body, link, computeLinkVelocity=1)
+        return _point_velocity(state[0], state[6], state[7], point)[0]
+
+    def _name_of(self, body: int) -> str:
+        return next(name for name in self.model_names() if self.body_of(name) == body)
 
     def models_not_finite(self) -> List[str]:
         """The robots and moving world models whose base pose the last steps made NaN or infinite. Run after every
@@ -468,59 +599,83 @@ class Engine:
             self.client = None
 
     def _load_urdf(self, model: RobotModel, pose: Pose) -> int:
-        # PyBullet reads URDF only from a file; a private temp file keeps the source tree untouched.
-        handle, path = tempfile.mkstemp(prefix="mbot_sim_bridge_", suffix=".urdf")
+        # PyBullet reads URDF only from a file; a private temp folder keeps the source tree untouched and holds
+        # the binary copies of STL meshes PyBullet cannot read.
+        with tempfile.TemporaryDirectory(prefix="mbot_sim_bridge_") as folder:
+            return self._load_urdf_in(model, pose, folder)
+
+    def _load_urdf_in(self, model: RobotModel, pose: Pose, folder: str) -> int:
+        path = os.path.join(folder, "model.urdf")
+        with open(path, "w") as urdf_file:
+            urdf_file.write(with_pybullet_readable_meshes(model.pybullet_urdf, folder))
         try:
-            with os.fdopen(handle, "w") as urdf_file:
-                urdf_file.write(model.pybullet_urdf)
-            flags = (pybullet.URDF_MERGE_FIXED_LINKS | pybullet.URDF_USE_INERTIA_FROM_FILE
-                     | pybullet.URDF_USE_IMPLICIT_CYLINDER)
-            # PyBullet's URDF importer prints its link merging; keep it out of the node's output.
+            # Fixed joints come lumped (RobotModel), so PyBullet's URDF_MERGE_FIXED_LINKS is not asked for.
+            flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
+            # PyBullet's URDF importer prints what it does; keep it out of the node's output.
             with open(os.devnull, "w") as devnull, c_stdout_to(devnull):
                 body = self.client.loadURDF(path, flags=flags, useFixedBase=model.anchored)
         except pybullet.error as error:
             raise ModelError(f"PyBullet could not load model '{model.name}': {error}") from None
-        finally:
-            os.unlink(path)
         com = compose(pose, inverse(root_from_com(self.client, body)))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         return body
 
     def set_surfaces(self, robot: SpawnedRobot, driven_joints: Sequence[str]):
-        """Friction of every link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
+        """Friction of every Bullet link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
         robot.driven_joints = tuple(driven_joints)
         casters = set(robot.model.caster_links(driven_joints))
         if casters:
             _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
-        for link_name, index in robot.link_index.items():
-            self._set_surface(robot, link_name, index, caster=link_name in casters)
+        source = f"model '{robot.name}'"
+        # The wheels that carry fdir1 get the wheel contact model; Gazebo's ODE too turns friction with them only.
+        modelled = {link_name: wheel_axle for link_name, wheel_axle in robot.model.wheels.items()
+                    if robot.model.fdir1(link_name, source) is not None and link_name in robot.link_index}
+        for link_name, index in {**robot.link_index, **robot.surface_link_index}.items():
+            self._set_surface(robot, link_name, index, caster=link_name in casters, modelled=link_name in modelled)
+        mass = sum(self.client.getDynamicsInfo(robot.body, index)[0] for index in range(-1, robot.client.getNumJoints(
+            robot.body)))
+        contacts = []
+        driven_links = {robot.model.joints[joint].child for joint in driven_joints if joint in robot.model.joints}
+        for link_name, (centre, axle) in modelled.items():
+            index = robot.link_index[link_name]
+            mu1, mu2 = robot.model.links[link_name].surface(source)
+            if max(mu1, mu2) > MAX_WHEEL_MU:
+                warn_once(_logger, f"{robot.name}: link '{link_name}' mu1 {mu1:g} / mu2 {mu2:g}: a wheel's friction "
+                                   f"is taken as at most {MAX_WHEEL_MU:g} (beyond, its force would overflow)")
+                mu1, mu2 = min(mu1, MAX_WHEEL_MU), min(mu2, MAX_WHEEL_MU)
+            share = mass / len(robot.model.wheels)
+            along = share if link_name in driven_links else 1.0 / (
+                1.0 / share + robot.model.links[link_name].collision_radii[0] ** 2 / self._axle_inertia(
+                    robot.body, index, axle))
+            contacts.append(wheel(index, centre, axle, robot.model.fdir1(link_name, source), mu1, mu2,
+                                  (along, share), self.physics.max_step_size))
+        for link_name, link in robot.model.links.items():
+            if link.gazebo_tag("fdir1") is not None and link_name not in robot.model.wheels:
+                warn_once(_logger, f"{robot.name}: link '{link_name}' <fdir1> acts on wheels only (cylinders about "
+                                   "their joint's axis); ignored")
+        self._set_wheels(robot.body, WheelContacts(self.client, robot.body, contacts) if contacts else None)
 
-    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool):
-        mu = DEFAULT_MU
-        # sdformat keeps a lumped link's <gazebo reference> surface on the collisions it brings to its parent
-        # (a base_link lumped into a base_footprint root keeps its mu); Bullet has one friction per link.
-        frictions = {}
-        for name, (body_link, _) in robot.model.lumped_into.items():
-            link = robot.model.links.get(name)
-            if body_link != link_name or link is None or (name != link_name and not link.collision_kinds):
-                continue
-            mu1, mu2 = link.gazebo_tag("mu1"), link.gazebo_tag("mu2")
-            values = [_friction(v, robot.name, name) for v in (mu1, mu2) if v is not None]
-            if len(values) == 2 and values[0] != values[1]:
-                warn_once(_logger, f"{robot.name}: link '{name}' has mu1 {mu1} and mu2 {mu2}; Bullet's friction "
-                                   "is isotropic, the smaller is used")
-            if values:
-                frictions[name] = min(values)
-        if len(set(frictions.values())) > 1:
-            warn_once(_logger, f"{robot.name}: links lumped into '{link_name}' have different friction ("
-                               f"{', '.join(f'{name} {value:g}' for name, value in sorted(frictions.items()))}); "
-                               "Bullet has one per link, the smallest is used")
-        if frictions:
-            mu = min(frictions.values())
-        if caster:
-            mu = 0.0
-        self.client.changeDynamics(robot.body, index, lateralFriction=mu, spinningFriction=0.0,
-                                   rollingFriction=0.0, restitution=0.0)
+    def _axle_inertia(self, body: int, index: int, axle: Sequence[float]) -> float:
+        """A link's moment of inertia about an axis through its centre of mass along ``axle`` (its frame)."""
+        info = self.client.getDynamicsInfo(body, index)
+        inertial_axle = rotate(inverse(Pose((0.0, 0.0, 0.0), tuple(info[4]))).orientation, axle)
+        return max(sum(moment * value * value for moment, value in zip(info[2], inertial_axle)), 1e-12)
+
+    def _set_wheels(self, body: int, contacts: Optional[WheelContacts]):
+        if contacts is None:
+            self._wheels.pop(body, None)
+        else:
+            self._wheels[body] = contacts
+        self._before_step = [wheels.apply for wheels in self._wheels.values()]
+
+    def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, modelled: bool):
+        mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")
+        if mu1 != mu2 and not modelled:
+            warn_once(_logger, f"{robot.name}: link '{link_name}' has mu1 {mu1:g} and mu2 {mu2:g}; Bullet's friction "
+                               "is isotropic, the smaller is used")
+        # A wheel's friction is the wheel contact model's (wheel_contact), not Bullet's.
+        self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or modelled else min(mu1, mu2),
+                                   spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)

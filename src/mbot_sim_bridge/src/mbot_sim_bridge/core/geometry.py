@@ -16,6 +16,7 @@ class Pose(NamedTuple):
     orientation: Tuple[float, float, float, float]  # x, y, z, w
 
 
+Vector = Tuple[float, float, float]
 IDENTITY = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 

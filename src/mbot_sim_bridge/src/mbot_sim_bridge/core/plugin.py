@@ -5,25 +5,57 @@ computes its outputs, with no ROS), one ROS module (a subclass that adds the pub
 and one line in the plugin table (``core/plugin_table.py``). The Simulation builds every plugin the same way, calls
 ``update(now)`` when its timer is due and ``on_step`` after each physics step if it asks for it.
 """
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Dict, Optional, Sequence, Tuple
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Protocol, Sequence, Tuple
 from xml.etree import ElementTree
 
 import numpy as np
 
+from .body_wrenches import BodyWrenches
 from .clock import UpdateTimer
 from .names import plugin_namespace
 from .errors import ConfigError
+from .parameters import Parameters
 from .params import Param, PluginParams
 
-if TYPE_CHECKING:  # imported for the annotations only: the Simulation imports this module
-    from .simulation import Simulation, SpawnedModel
+if TYPE_CHECKING:  # for the annotations only: neither imports this module
+    from .cameras.render_scene import RenderScene
+    from .engine import Engine, SpawnedRobot
+
+
+class PluginHost(Protocol):
+    """What a plugin uses of the simulation that runs it (``simulation.Simulation``), and nothing more: plugins
+    depend on this, not on the Simulation, which builds them."""
+    engine: "Engine"
+    parameters: Parameters
+    package_uris: Callable[[str], str]
+    wrenches: BodyWrenches
+
+    @property
+    def sim_time(self) -> float: ...
+
+    @property
+    def step_size(self) -> float: ...
+
+    @property
+    def render_scene(self) -> "RenderScene": ...
+
+    def random_stream(self, model_name: str, key: str) -> np.random.Generator: ...
+
+
+@dataclass
+class SpawnedModel:
+    """A robot spawned from URDF, with the plugins built from its <gazebo> blocks."""
+    name: str
+    namespace: str
+    robot: "SpawnedRobot"
+    plugins: List["Plugin"] = field(default_factory=list)
 
 
 @dataclass
 class PluginContext:
-    simulation: "Simulation"
-    model: "SpawnedModel"
+    simulation: PluginHost
+    model: SpawnedModel
     link: Optional[str] = None  # a sensor plugin's link (the <gazebo reference>), lumped or not
 
     @property
@@ -135,6 +167,9 @@ class Plugin:
     def idle(self, now: float):
         """When ``timer`` is due but nothing takes the outputs (the ROS layer calls it instead of ``update``
         while no one subscribes, as gazebo_ros's sensors work only then): keep what the next update needs."""
+
+    def joints_set(self, positions: Dict[str, float]):
+        """set_model_configuration put these joints at these positions, at rest, between two steps."""
 
     def reset(self, now: float):
         """World or simulation reset (Gazebo calls the plugin's Reset())."""

@@ -3,43 +3,46 @@
 This is the one plugin table. The ROS node's registry (``plugins/registry.py``) is derived from it, and the demo,
 the benchmarks and the tests build their Simulations from it; adding a plugin adds one line here.
 
-A line names its class as ``module.Class`` of this package, imported when a model first uses the file name, as
-Gazebo loads a plugin's library only when a model names it: a launch imports the plugins its models use, not all
-of them (importing every plugin, with its ROS side, took 30 ms of the simulator's start-up).
+A line names its class as ``module.Class`` relative to this package (``drives.diff_drive.DiffDrive``), imported
+when a model first uses the file name, as Gazebo loads a plugin's library only when a model names it: a launch
+imports the plugins its models use, not all of them (importing every plugin, with its ROS side, took 30 ms of the
+simulator's start-up).
 """
 import importlib
 from typing import Callable, Dict, Iterable, Iterator, Mapping
 
 _REFERENCES: Dict[str, str] = {
-    "libgazebo_ros_control.so": "gazebo_ros_control.GazeboRosControlPlugin",
-    "libgazebo_ros_diff_drive.so": "diff_drive.DiffDrive",
-    "libgazebo_ros_joint_state_publisher.so": "joint_states.JointStatePublisher",
-    "libgazebo_ros_laser.so": "lidar.RaySensor",
-    "libgazebo_ros_gpu_laser.so": "lidar.RaySensor",
-    "libgazebo_ros_camera.so": "camera.Camera",
-    "libgazebo_ros_multicamera.so": "multicamera.MultiCamera",
-    "libgazebo_ros_openni_kinect.so": "camera.DepthCamera",
-    "libgazebo_ros_depth_camera.so": "camera.PlainDepthCamera",
-    "libgazebo_ros_imu.so": "imu.ImuModelPlugin",
-    "libgazebo_ros_imu_sensor.so": "imu.ImuSensor",
-    "libgazebo_ros_p3d.so": "p3d.P3D",
-    "libgazebo_ros_f3d.so": "f3d.F3D",
-    "libgazebo_ros_ft_sensor.so": "ft_sensor.FTSensor",
-    "libgazebo_ros_planar_move.so": "planar_move.PlanarMove",
-    "libgazebo_ros_skid_steer_drive.so": "skid_steer_drive.SkidSteerDrive",
-    "libgazebo_ros_tricycle_drive.so": "tricycle_drive.TricycleDrive",
-    "libhector_gazebo_ros_imu.so": "hector_imu.HectorImu",
-    "libhector_gazebo_ros_gps.so": "hector_gps.HectorGps",
-    "libhector_gazebo_ros_magnetic.so": "hector_magnetic.HectorMagnetic",
-    "libgazebo_ros_range.so": "range_sensor.RangeSensor",
-    "libgazebo_ros_bumper.so": "bumper.Bumper",
-    "libhector_gazebo_ros_sonar.so": "range_sensor.HectorSonar",
-    "libgazebo_ros_velodyne_laser.so": "velodyne_laser.VelodyneLaser",
-    "libgazebo_ros_velodyne_gpu_laser.so": "velodyne_laser.VelodyneLaser",
-    "libgazebo_ros_block_laser.so": "block_laser.BlockLaser",
-    "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": "mimic_joint.MimicJoint",
+    "libgazebo_ros_control.so": "ros_control.gazebo_ros_control.GazeboRosControlPlugin",
+    "libgazebo_ros_diff_drive.so": "drives.diff_drive.DiffDrive",
+    "libgazebo_ros_joint_state_publisher.so": "joints.joint_states.JointStatePublisher",
+    "libgazebo_ros_laser.so": "sensors.lidar.RaySensor",
+    "libgazebo_ros_gpu_laser.so": "sensors.lidar.RaySensor",
+    "libgazebo_ros_camera.so": "cameras.camera.Camera",
+    "libgazebo_ros_multicamera.so": "cameras.multicamera.MultiCamera",
+    "libgazebo_ros_openni_kinect.so": "cameras.camera.DepthCamera",
+    "libgazebo_ros_depth_camera.so": "cameras.camera.PlainDepthCamera",
+    "libgazebo_ros_imu.so": "sensors.imu.ImuModelPlugin",
+    "libgazebo_ros_imu_sensor.so": "sensors.imu.ImuSensor",
+    "libgazebo_ros_p3d.so": "sensors.p3d.P3D",
+    "libgazebo_ros_f3d.so": "sensors.f3d.F3D",
+    "libgazebo_ros_ft_sensor.so": "sensors.ft_sensor.FTSensor",
+    "libgazebo_ros_planar_move.so": "drives.planar_move.PlanarMove",
+    "libgazebo_ros_skid_steer_drive.so": "drives.skid_steer_drive.SkidSteerDrive",
+    "libgazebo_ros_tricycle_drive.so": "drives.tricycle_drive.TricycleDrive",
+    "libhector_gazebo_ros_imu.so": "hector.hector_imu.HectorImu",
+    "libhector_gazebo_ros_gps.so": "hector.hector_gps.HectorGps",
+    "libhector_gazebo_ros_magnetic.so": "hector.hector_magnetic.HectorMagnetic",
+    "libgazebo_ros_range.so": "sensors.range_sensor.RangeSensor",
+    "libgazebo_ros_bumper.so": "sensors.bumper.Bumper",
+    "libhector_gazebo_ros_sonar.so": "sensors.range_sensor.HectorSonar",
+    "libgazebo_ros_velodyne_laser.so": "sensors.velodyne_laser.VelodyneLaser",
+    "libgazebo_ros_velodyne_gpu_laser.so": "sensors.velodyne_laser.VelodyneLaser",
+    "libgazebo_ros_block_laser.so": "sensors.block_laser.BlockLaser",
+    "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": "joints.mimic_joint.MimicJoint",
     # The same plugin under the package's name before 2020.
-    "libroboticsgroup_gazebo_mimic_joint_plugin.so": "mimic_joint.MimicJoint",
+    "libroboticsgroup_gazebo_mimic_joint_plugin.so": "joints.mimic_joint.MimicJoint",
+    # gazebo_plugins' template, which does nothing: the starting point of a new plugin.
+    "libgazebo_ros_template.so": "template.Template",
 }
 
 
@@ -76,5 +79,5 @@ CORE_PLUGINS: Mapping[str, type] = LazyClassTable(_REFERENCES, _import)
 
 def filename_of(plugin_class: type) -> str:
     """The (first) file name under which the core class ``plugin_class`` is in the table; imports no other."""
-    reference = f"{plugin_class.__module__.rpartition('.')[2]}.{plugin_class.__name__}"
+    reference = f"{plugin_class.__module__[len(__package__) + 1:]}.{plugin_class.__name__}"
     return next(filename for filename, entry in _REFERENCES.items() if entry == reference)

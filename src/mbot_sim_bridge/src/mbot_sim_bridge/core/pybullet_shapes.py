@@ -8,7 +8,7 @@ import pybullet
 
 from .geometry import IDENTITY, Pose
 from .log import get_logger, warn_once
-from .world_description import Shape
+from .description.world_description import Shape
 
 _log = get_logger(__name__)
 

@@ -7,55 +7,47 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 ROS layer's registry derived from it, so the core never imports the ROS plugin layer.
 """
 import hashlib
-import math
 import sys
-from dataclasses import dataclass, field, replace
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
+from dataclasses import replace
+from typing import Callable, Dict, List, Mapping, NamedTuple, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
 
 import numpy as np
 import pybullet
 
-from .body_wrenches import WORLD_FRAMES, BodyWrenches, WrenchJob, target_wrench
-from .engine import Engine, SpawnedRobot
+from .added_plugins import joint_state_blocks, mimic_blocks
+from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
+from .engine import Engine, frame_velocity
 from .errors import ConfigError, ModelError
-from .geometry import IDENTITY, Pose, compose, inverse
-from .joint_states import JointStatePublisher
+from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
+from .joints.model_configuration import requested_positions
 from .log import get_logger, warn_once
-from .mimic_joint import MimicJoint
 from .parameters import Parameters
-from .plugin import Plugin, PluginContext
-from .plugin_table import filename_of
-from .render_scene import RenderScene
-from .robot_model import RobotModel
-from .world_description import ModelDescription, WorldDescription
+from .plugin import Plugin, PluginContext, SpawnedModel
+from .cameras.render_scene import RenderScene
+from .description.robot_model import RobotModel
+from .description.world_description import ModelDescription, WorldDescription
 from .viewer import Viewer
 from .world_bodies import load_world
 
 _logger = get_logger(__name__)
 
-# The bridge publishes the joint states no plugin publishes through this plugin, as a Gazebo user would add it.
-JOINT_STATE_PLUGIN = filename_of(JointStatePublisher)
-# And a URDF <mimic> joint through roboticsgroup's mimic joint plugin.
-MIMIC_PLUGIN = filename_of(MimicJoint)
 # Above this many links a spawn takes seconds (PyBullet's URDF import): said first, so a pause is explained.
 LARGE_MODEL_LINKS = 1000
 # Sim time covered by one batch of physics steps at most, so requests and shutdown are served promptly.
 MAX_BATCH_SIM_SECONDS = 0.01
-# apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
-MAX_WRENCH = 1e6
+
+
+class ModelProperties(NamedTuple):
+    """get_model_properties' answer: link (body) names, collision (geom) names, joint names, static."""
+    body_names: List[str]
+    geom_names: List[str]
+    joint_names: List[str]
+    is_static: bool
+
 
 # Called before the due plugins update: (sim time, whether any plugin is due). The node publishes /clock there.
 BeforeUpdates = Callable[[float, bool], None]
-
-
-@dataclass
-class SpawnedModel:
-    """A robot spawned from URDF, with the plugins built from its <gazebo> blocks."""
-    name: str
-    namespace: str
-    robot: SpawnedRobot
-    plugins: List[Plugin] = field(default_factory=list)
 
 
 class Simulation:
@@ -179,21 +171,11 @@ class Simulation:
     # -- wrenches from outside (apply_body_wrench) ---------------------------------------------------------------
     def apply_body_wrench(self, body: str, reference_frame: str, reference_point, force, torque, start_time: float,
                           duration: float):
-        """Schedule a wrench on link ``body`` ("model::link"), as gazebo_ros's apply_body_wrench (body_wrenches.py);
-        an unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite
-        or beyond MAX_WRENCH (the physics would turn the model's state NaN)."""
-        model, link = self._split_link(body, "ApplyBodyWrench: body does not exist")
-        values = [*reference_point, *force, *torque]
-        if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
-            raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
-                             f"at most {MAX_WRENCH:g} in size; got {values}")
-        frame_pose = None
-        if reference_frame not in WORLD_FRAMES:
-            frame_pose = self._entity_pose(reference_frame)
-            if frame_pose is None:
-                raise ModelError(f"ApplyBodyWrench: reference_frame '{reference_frame}' is not a valid entity name")
-        force, torque = target_wrench(force, torque, reference_point, self._link_pose(model, link), frame_pose)
-        self.wrenches.add(WrenchJob(model, link, force, torque, max(start_time, self.sim_time), duration))
+        """Schedule a wrench on link ``body`` ("model::link"), as gazebo_ros's apply_body_wrench; the request is
+        checked and made a job by ``body_wrenches.requested_job`` (ModelError with upstream's message)."""
+        self.wrenches.add(requested_job(body, reference_frame, reference_point, force, torque,
+                                        max(start_time, self.sim_time), duration, self.link_names, self._link_pose,
+                                        self._entity_pose))
 
     def clear_body_wrenches(self, body: str):
         model, _, link = body.partition("::")
@@ -206,13 +188,6 @@ class Simulation:
         if model in self.world_models:
             return [link.name for link in self.world_models[model].links]
         return []
-
-    def _split_link(self, body: str, failure: str) -> Tuple[str, str]:
-        model, _, link = body.partition("::")
-        if link not in self.link_names(model):
-            known = ", ".join(f"{model}::{name}" for name in self.link_names(model)) or "no such model"
-            raise ModelError(f"{failure}: '{body}' ({known})")
-        return model, link
 
     def _link_pose(self, model: str, link: str) -> Pose:
         if model in self.models:
@@ -229,6 +204,49 @@ class Simulation:
         model, _, link = name.partition("::")
         return self._link_pose(model, link) if link in self.link_names(model) else None
 
+    def _entity_twist(self, name: str) -> Tuple[Vector, Vector]:
+        """World (linear velocity of the frame's origin, angular velocity) of a model or an existing "model::link"."""
+        if name in self.model_names():
+            return self.engine.model_velocity(name)
+        model, _, link = name.partition("::")
+        if model in self.models:
+            return self.models[model].robot.link_world_velocity(link)
+        return frame_velocity(self.engine.client, self.engine.body_of(model), self._link_pose(model, link).position)
+
+    def link_state(self, link_name: str, reference_frame: str) -> Tuple[Pose, Vector, Vector]:
+        """get_link_state: a "model::link"'s pose and (linear, angular) velocity relative to any entity, as
+        gazebo_ros computes them (the velocities are the differences with the frame's, rotated into it)."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError("GetLinkState: link not found, did you forget to scope the link by model name?")
+        pose, (linear, angular) = self._link_pose(model, link), self._entity_twist(link_name)
+        frame = self._entity_pose(reference_frame)
+        if frame is None:
+            if reference_frame in WORLD_FRAMES:
+                return pose, tuple(linear), tuple(angular)
+            raise ModelError("GetLinkState: reference reference_frame not found, did you forget to scope the link by "
+                             "model name?")
+        frame_linear, frame_angular = self._entity_twist(reference_frame)
+        back = inverse(frame)
+        return (compose(back, pose), rotate(back.orientation, np.subtract(linear, frame_linear)),
+                rotate(back.orientation, np.subtract(angular, frame_angular)))
+
+    def model_properties(self, name: str) -> ModelProperties:
+        """get_model_properties: the links and joints the physics has (a robot's after fixed-joint lumping, as
+        Gazebo's), their collisions by sdformat's names; no nested models."""
+        if name not in self.model_names():
+            raise ModelError("GetModelProperties: model does not exist")
+        if name in self.models:
+            robot = self.models[name].robot
+            collisions = robot.model.collision_names()
+            return ModelProperties(list(robot.link_index), [collision for link in robot.link_index
+                                                            for collision in collisions.get(link, [])],
+                                   list(robot.joint_index), False)
+        description = self.world_models[name]
+        return ModelProperties([link.name for link in description.links],
+                               [shape.name for link in description.links for shape in link.collisions], [],
+                               description.static)
+
     def _apply_wrenches(self):
         for (model, link), (force, torque) in self.wrenches.due(self.sim_time).items():
             if model in self._frozen:
@@ -244,6 +262,22 @@ class Simulation:
         self.engine.set_model_state(name, pose, linear, angular)
         self.version += 1
 
+    def set_model_configuration(self, name: str, joint_names: Sequence[str], positions: Sequence[float]) -> List[str]:
+        """set_model_configuration: joints of robot ``name`` set exactly, at rest, before its next step, its
+        plugins told (ros_control's controllers then start from, or hold, the new positions); returns the
+        requested joints the model has none of (ignored, as Gazebo ignores them). A world model has no joints."""
+        if name not in self.model_names():
+            raise ModelError("SetModelConfiguration: model does not exist")
+        spawned = self.models.get(name)
+        joints, movable = (spawned.robot.model.joints, spawned.robot.movable_joints) if spawned else ({}, ())
+        wanted, missing = requested_positions(joints, movable, joint_names, positions)
+        if wanted:
+            self.engine.set_joint_positions(spawned.robot, wanted)
+            self.version += 1
+            for plugin in list(spawned.plugins):
+                self._guarded(plugin, plugin.joints_set, wanted)
+        return missing
+
     def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
         plugins: List[Plugin] = []
         model = spawned.robot.model
@@ -256,18 +290,11 @@ class Simulation:
                                    "no ROS plugin; nothing is published for it")
             for element in elements:
                 plugins.extend(self._create_plugin(spawned, element, sensor, link_name))
-        mimicked = {plugin.follower for plugin in plugins if isinstance(plugin, MimicJoint)}
-        for joint in model.joints.values():
-            if joint.mimic is not None and joint.name not in mimicked:
-                leader, multiplier, offset = joint.mimic
-                element = MimicJoint.plugin_element(MIMIC_PLUGIN, f"{joint.name}_mimic", joint=leader,
-                                                    mimicJoint=joint.name, multiplier=repr(multiplier),
-                                                    offset=repr(offset))
-                plugins.extend(self._create_plugin(spawned, element, None, None))
-        published = {joint for plugin in plugins for joint in plugin.joint_states_published}
-        remaining = [joint for joint in spawned.robot.movable_joints if joint not in published]
-        if remaining:
-            plugins.extend(self._create_plugin(spawned, self._joint_state_element(spawned, remaining), None, None))
+        for element in mimic_blocks(model, plugins):
+            plugins.extend(self._create_plugin(spawned, element, None, None))
+        for element in joint_state_blocks(spawned.robot.movable_joints, plugins, spawned.namespace,
+                                          self.joint_state_rate):
+            plugins.extend(self._create_plugin(spawned, element, None, None))
         return plugins
 
     def _create_plugin(self, spawned: SpawnedModel, element: ElementTree.Element,
@@ -292,12 +319,6 @@ class Simulation:
                               f"sensor '{sensor.get('name')}' has type \"{sensor.get('type')}\"")
         context = PluginContext(self, spawned, link_name)
         return [plugin_class(context, element, sensor)]
-
-    def _joint_state_element(self, spawned: SpawnedModel, joints: Sequence[str]) -> ElementTree.Element:
-        """The libgazebo_ros_joint_state_publisher.so block a Gazebo user would add for these joints."""
-        return JointStatePublisher.plugin_element(JOINT_STATE_PLUGIN, "bridge_joint_state_publisher",
-                                                  robotNamespace=spawned.namespace, jointName=", ".join(joints),
-                                                  updateRate=repr(self.joint_state_rate))
 
     def _schedule(self):
         self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
@@ -433,6 +454,12 @@ class Simulation:
             else:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
                 self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
+
+    def __enter__(self) -> "Simulation":
+        return self
+
+    def __exit__(self, *exception):
+        self.close()
 
     def close(self):
         for name in list(self.models):

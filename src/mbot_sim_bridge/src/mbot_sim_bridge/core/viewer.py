@@ -6,7 +6,7 @@ import pybullet
 
 from .engine import Engine, SpawnedRobot
 from .geometry import yaw
-from .materials import colour_robot
+from .description.materials import colour_robot
 
 # Close enough to see the 0.32 m mbot and what is around it, from behind and above.
 _CAMERA_DISTANCE, _CAMERA_PITCH_DEGREES = 1.2, -30.0

@@ -12,7 +12,7 @@ import numpy as np
 from .geometry import IDENTITY, Pose, compose, inverse, rotation_matrix
 from .log import get_logger, warn_once
 from .pybullet_shapes import collision_shape, welded_body
-from .world_description import ModelDescription, PhysicsConfig, Shape, WorldDescription
+from .description.world_description import ModelDescription, PhysicsConfig, Shape, WorldDescription
 
 _log = get_logger(__name__)
 

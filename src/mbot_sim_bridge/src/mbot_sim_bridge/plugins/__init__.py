@@ -62,6 +62,14 @@ class RosPlugin:
         self.topics = PluginTopics()
         super().__init__(*args, **kwargs)
 
+    def nobody_listens(self, now: float, *publishers: Optional[LoopPublisher]) -> bool:
+        """Whether none of ``publishers`` has a subscriber; the core then idles (``idle(now)``) and the update
+        stops there, as gazebo_ros's sensors work only while someone listens."""
+        if self.topics.listened(*publishers):
+            return False
+        self.idle(now)
+        return True
+
     def close(self):
         self.topics.close()
         super().close()

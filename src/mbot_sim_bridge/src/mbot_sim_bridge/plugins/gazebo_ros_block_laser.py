@@ -4,7 +4,7 @@ import rospy
 from geometry_msgs.msg import Point32
 from sensor_msgs.msg import ChannelFloat32, PointCloud
 
-from ..core.block_laser import BlockLaser
+from ..core.sensors.block_laser import BlockLaser
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 
@@ -21,7 +21,7 @@ class GazeboRosBlockLaser(RosPlugin, BlockLaser):
                       f"of {config.range_count} points at {config.update_rate:g} Hz")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         cloud = self.cloud()
         message = PointCloud()

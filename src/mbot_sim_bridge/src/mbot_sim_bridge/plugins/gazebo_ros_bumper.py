@@ -3,7 +3,7 @@ import rospy
 from gazebo_msgs.msg import ContactsState, ContactState
 from geometry_msgs.msg import Vector3, Wrench
 
-from ..core.bumper import Bumper
+from ..core.sensors.bumper import Bumper
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import set_xyz
@@ -32,7 +32,7 @@ class GazeboRosBumper(RosPlugin, Bumper):
         rospy.loginfo(f"{self.label}: contacts of '{self.collision_name}' -> {self.publisher.resolved_name}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         message = ContactsState()

@@ -3,7 +3,7 @@ someone subscribes to either."""
 import rospy
 from sensor_msgs.msg import CameraInfo, Image
 
-from ..core.camera import Camera
+from ..core.cameras.camera import Camera
 from ..core.names import resolve_frame
 from . import RosPlugin, ros_time
 from .messages import camera_info_message, image_message
@@ -32,9 +32,9 @@ class GazeboRosCamera(RosPlugin, Camera):
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor renders only while the image or camera_info has a subscriber.
-        image_wanted = self.topics.listened(self.image_publisher)
-        if not image_wanted and not self.topics.listened(self.info_publisher):
+        if self.nobody_listens(now, self.image_publisher, self.info_publisher):
             return
+        image_wanted = self.topics.listened(self.image_publisher)
         if not self.throttle.passes(now):
             return
         stamp = ros_time(now)

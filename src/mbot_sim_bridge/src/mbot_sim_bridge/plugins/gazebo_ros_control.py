@@ -15,7 +15,7 @@ from controller_manager_msgs.srv import (ListControllers, ListControllersRespons
                                          UnloadControllerResponse)
 from std_msgs.msg import Bool
 
-from ..core.gazebo_ros_control import GazeboRosControlPlugin
+from ..core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .ros_controllers import ROS_CONTROLLERS

@@ -1,7 +1,7 @@
 """``libgazebo_ros_depth_camera.so``: the openni_kinect plugin's topics (gazebo_ros_openni_kinect.py)."""
 import rospy
 
-from ..core.camera import PlainDepthCamera
+from ..core.cameras.camera import PlainDepthCamera
 from .gazebo_ros_openni_kinect import GazeboRosOpenniKinect
 
 

@@ -5,19 +5,13 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
-from ..core.diff_drive import ODOM_POSE_COVARIANCE, DiffDrive
+from ..core.drives.diff_drive import DiffDrive
+from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
 from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
+from .ground_truth_odometry import on_twist
 from .messages import set_pose, set_quaternion, set_xyz
-
-
-def on_twist(plugin, message: Twist):
-    """cmd_vel to a TwistCommand drive; a non-finite one is refused with a throttled warning."""
-    linear, angular = message.linear.x, message.angular.z
-    if not plugin.set_command(linear, angular):
-        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a non-finite value "
-                                    f"(linear.x {linear}, angular.z {angular}); keeping the last valid command")
 
 
 class GazeboRosDiffDrive(RosPlugin, DiffDrive):
@@ -37,7 +31,7 @@ class GazeboRosDiffDrive(RosPlugin, DiffDrive):
                                                        JointState) if self.joint_states_published else None)
         self._make_messages()
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
-        topics.own(TrackedSubscriber(self.command_topic, Twist, self._on_command))
+        topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
         if params["publishWheelTF"]:
             rospy.loginfo(f"{self.label}: publishWheelTF: the wheel frames reach /tf through robot_state_publisher "
                           "from joint_states; they are not broadcast a second time (that duplicate is what makes "
@@ -48,9 +42,6 @@ class GazeboRosDiffDrive(RosPlugin, DiffDrive):
                       f"torque {self.torque:.1f} N·m, acceleration {self.ramp.acceleration:.2f} m/s², "
                       f"{params['odometrySource']} odometry on {odometry} at {params['updateRate']:.0f} Hz, legacyMode "
                       f"{self.geometry.legacy_mode}")
-
-    def _on_command(self, message: Twist):
-        on_twist(self, message)
 
     def update(self, now: float):
         # Topics nobody listens to are skipped: the loop publishes synchronously, so each costs real time.

@@ -2,7 +2,7 @@
 physics step while subscribed."""
 import rospy
 
-from ..core.f3d import F3D
+from ..core.sensors.f3d import F3D
 from .wrench_topic import WrenchTopic
 
 

@@ -2,7 +2,7 @@
 subscribed."""
 import rospy
 
-from ..core.ft_sensor import FTSensor
+from ..core.sensors.ft_sensor import FTSensor
 from .wrench_topic import WrenchTopic
 
 

@@ -3,7 +3,7 @@ import rospy
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Empty, EmptyResponse
 
-from ..core.imu import ImuModelPlugin
+from ..core.sensors.imu import ImuModelPlugin
 from . import RosPlugin, resolve_in_namespace
 from .messages import imu_records
 
@@ -22,8 +22,7 @@ class GazeboRosImu(RosPlugin, ImuModelPlugin):
         rospy.loginfo(f"{self.label}: link '{self.link}' -> {topic} (frame '{self.frame_name}') {rate}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
-            self.idle(now)
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         self.publisher.publish_records(imu_records(self.readings, self.frame_name))

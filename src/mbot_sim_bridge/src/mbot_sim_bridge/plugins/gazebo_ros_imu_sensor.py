@@ -2,7 +2,7 @@
 import rospy
 from sensor_msgs.msg import Imu
 
-from ..core.imu import ImuSensor
+from ..core.sensors.imu import ImuSensor
 from . import RosPlugin, resolve_in_namespace
 from .messages import imu_message
 
@@ -17,8 +17,7 @@ class GazeboRosImuSensor(RosPlugin, ImuSensor):
                       f"{self.publisher.resolved_name} (frame '{self.params['frameName']}') at {rate}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
-            self.idle(now)
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         self.publisher.publish(imu_message(self.latest, self.params["frameName"]))

@@ -1,7 +1,7 @@
 """``libgazebo_ros_joint_state_publisher.so``: sensor_msgs/JointState of the named joints."""
 from sensor_msgs.msg import JointState
 
-from ..core.joint_states import JointStatePublisher
+from ..core.joints.joint_states import JointStatePublisher
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 
@@ -12,7 +12,7 @@ class GazeboRosJointStatePublisher(RosPlugin, JointStatePublisher):
         self.message = JointState(name=self.joint_names)  # refilled at each update
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         message = self.message
         message.header.stamp = ros_time(now)

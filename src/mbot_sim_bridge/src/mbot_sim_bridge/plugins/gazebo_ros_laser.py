@@ -2,7 +2,7 @@
 import rospy
 from sensor_msgs.msg import LaserScan
 
-from ..core.lidar import RaySensor
+from ..core.sensors.lidar import RaySensor
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 
@@ -26,7 +26,7 @@ class GazeboRosLaser(RosPlugin, RaySensor):
 
     def update(self, now: float):
         # As in gazebo_ros, the sensor works only while someone listens.
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         scan = self.scan()
         self.message.header.stamp = ros_time(now)

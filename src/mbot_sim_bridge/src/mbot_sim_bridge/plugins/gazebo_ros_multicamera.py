@@ -3,7 +3,7 @@
 import rospy
 from sensor_msgs.msg import CameraInfo, Image
 
-from ..core.multicamera import MultiCamera
+from ..core.cameras.multicamera import MultiCamera
 from ..core.names import resolve_frame
 from . import RosPlugin, ros_time
 from .gazebo_ros_camera import camera_namespace

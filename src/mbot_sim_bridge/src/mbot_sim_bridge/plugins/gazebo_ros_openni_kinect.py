@@ -3,8 +3,8 @@ depth sensor, from one render per sensor frame, only while something is subscrib
 import rospy
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 
-from ..core.camera import DepthCamera
-from ..core.image_formats import POINT_FIELDS, POINT_STEP
+from ..core.cameras.camera import DepthCamera
+from ..core.cameras.image_formats import POINT_FIELDS, POINT_STEP
 from ..core.names import resolve_frame
 from . import RosPlugin, ros_time
 from .gazebo_ros_camera import camera_namespace

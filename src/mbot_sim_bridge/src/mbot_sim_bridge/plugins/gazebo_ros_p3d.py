@@ -2,7 +2,7 @@
 import rospy
 from nav_msgs.msg import Odometry
 
-from ..core.p3d import P3D
+from ..core.sensors.p3d import P3D
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance, set_pose, set_xyz
 
@@ -17,8 +17,7 @@ class GazeboRosP3D(RosPlugin, P3D):
                       f"'{self.frame_name}' {rate}")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
-            self.idle(now)
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         truth = self.latest

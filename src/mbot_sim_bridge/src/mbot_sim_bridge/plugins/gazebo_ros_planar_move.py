@@ -2,13 +2,12 @@
 import rospy
 from geometry_msgs.msg import Twist
 
-from ..core.diff_drive import ODOM_POSE_COVARIANCE
-from ..core.engine import MAX_SPEED
 from ..core.names import resolve_frame, tf_prefix
-from ..core.planar_move import PlanarMove
+from ..core.drives.planar_move import PlanarMove
+from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
-from .ground_truth_odometry import OdometryOutput
+from .ground_truth_odometry import OdometryOutput, on_twist
 
 
 class GazeboRosPlanarMove(RosPlugin, PlanarMove):
@@ -22,17 +21,10 @@ class GazeboRosPlanarMove(RosPlugin, PlanarMove):
         self.output = OdometryOutput(self.topics, resolve_in_namespace(namespace, params["odometryTopic"]),
                                      odom_frame, base_frame, ODOM_POSE_COVARIANCE, broadcast_tf=True)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
-        self.topics.own(TrackedSubscriber(self.command_topic, Twist, self._on_command))
+        self.topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
         rospy.loginfo(f"{self.label}: {self.command_topic} sets the base's velocity; odometry on "
                       f"{self.output.odom_publisher.resolved_name} at {params['odometryRate']:g} Hz, TF {odom_frame} "
                       f"-> {base_frame}")
-
-    def _on_command(self, message: Twist):
-        x, y, rotation = message.linear.x, message.linear.y, message.angular.z
-        if not self.set_command(x, y, rotation):
-            rospy.logwarn_throttle(5.0, f"{self.label}: ignored a {self.command_topic} with a value that is not "
-                                        f"finite or beyond {MAX_SPEED:g} (linear {x}, {y}, angular.z {rotation}); "
-                                        "keeping the last valid command")
 
     def update(self, now: float):
         super().update(now)

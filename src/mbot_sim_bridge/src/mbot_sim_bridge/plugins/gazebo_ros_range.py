@@ -3,7 +3,7 @@ import rospy
 from sensor_msgs.msg import Range
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.range_sensor import RangeSensor
+from ..core.sensors.range_sensor import RangeSensor
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 
@@ -21,7 +21,7 @@ class RangePublisher(RosPlugin):
                       f"{self.publisher.resolved_name} (frame {frame_id})")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         self.message.header.stamp = ros_time(now)

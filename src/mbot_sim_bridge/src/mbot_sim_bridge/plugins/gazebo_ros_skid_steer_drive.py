@@ -4,12 +4,11 @@ import rospy
 from geometry_msgs.msg import Twist
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.skid_steer_drive import SkidSteerDrive
+from ..core.drives.skid_steer_drive import SkidSteerDrive
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
-from .gazebo_ros_diff_drive import on_twist
 from .messages import diagonal_covariance
-from .ground_truth_odometry import OdometryOutput
+from .ground_truth_odometry import OdometryOutput, on_twist
 
 
 class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):

@@ -5,15 +5,11 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.tricycle_drive import TricycleDrive
+from ..core.drives.tricycle_drive import TricycleDrive
+from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
 from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace, ros_time
-from .gazebo_ros_diff_drive import on_twist
-from .ground_truth_odometry import OdometryOutput
-from .messages import diagonal_covariance
-
-# Upstream's pose covariance; the twist covariance stays zero.
-POSE_COVARIANCE = diagonal_covariance((1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3), 6)
+from .ground_truth_odometry import OdometryOutput, on_twist
 
 
 class GazeboRosTricycleDrive(RosPlugin, TricycleDrive):
@@ -24,7 +20,7 @@ class GazeboRosTricycleDrive(RosPlugin, TricycleDrive):
         prefix = tf_prefix(context.simulation.parameters, namespace)
         self.output = OdometryOutput(self.topics, resolve_in_namespace(namespace, params["odometryTopic"]),
                                      resolve_frame(params["odometryFrame"], prefix),
-                                     resolve_frame(params["robotBaseFrame"], prefix), POSE_COVARIANCE,
+                                     resolve_frame(params["robotBaseFrame"], prefix), ODOM_POSE_COVARIANCE,
                                      broadcast_tf=True)
         self.joint_state_publisher = (self.topics.publisher(resolve_in_namespace(namespace, "joint_states"),
                                                             JointState)

@@ -5,7 +5,7 @@ import rospy
 from sensor_msgs.msg import PointCloud2, PointField
 
 from ..core.names import resolve_frame, tf_prefix
-from ..core.velodyne_laser import VelodyneLaser
+from ..core.sensors.velodyne_laser import VelodyneLaser
 from . import RosPlugin, resolve_in_namespace, ros_time
 
 POINT = np.dtype({"names": ["x", "y", "z", "intensity", "ring", "time"],
@@ -32,7 +32,7 @@ class GazeboRosVelodyneLaser(RosPlugin, VelodyneLaser):
                       f"of {config.range_count} at {config.update_rate:g} Hz")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         cloud = self.cloud()
         points = np.zeros(len(cloud.ring), dtype=POINT)

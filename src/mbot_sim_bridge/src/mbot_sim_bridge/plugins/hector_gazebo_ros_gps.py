@@ -7,7 +7,7 @@ import rospy
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import NavSatFix
 
-from ..core.hector_gps import HectorGps
+from ..core.hector.hector_gps import HectorGps
 from ..core.log import get_logger, info_once
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance, set_xyz
@@ -29,7 +29,7 @@ class HectorGazeboRosGps(RosPlugin, HectorGps):
                       f"{self.velocity_publisher.resolved_name} (frame '{self.frame_id}')")
 
     def update(self, now: float):
-        if not self.topics.listened(self.fix_publisher, self.velocity_publisher):
+        if self.nobody_listens(now, self.fix_publisher, self.velocity_publisher):
             return
         super().update(now)
         reading = self.latest

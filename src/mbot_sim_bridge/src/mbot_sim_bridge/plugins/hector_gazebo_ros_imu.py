@@ -7,7 +7,7 @@ import rospy
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Empty, EmptyResponse
 
-from ..core.hector_imu import HectorImu
+from ..core.hector.hector_imu import HectorImu
 from ..core.log import get_logger, info_once
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import diagonal_covariance, set_quaternion, set_xyz
@@ -49,7 +49,7 @@ class HectorGazeboRosImu(RosPlugin, HectorImu):
         return EmptyResponse()
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher, self.bias_publisher):
+        if self.nobody_listens(now, self.publisher, self.bias_publisher):
             return
         super().update(now)
         reading = self.latest

@@ -4,7 +4,7 @@ import rospy
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import MagneticField
 
-from ..core.hector_magnetic import HectorMagnetic
+from ..core.hector.hector_magnetic import HectorMagnetic
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .messages import set_xyz
 
@@ -19,7 +19,7 @@ class HectorGazeboRosMagnetic(RosPlugin, HectorMagnetic):
         rospy.loginfo(f"{self.label}: link '{self.link}' -> {self.publisher.resolved_name} (frame '{self.frame_id}')")
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         message = MagneticField() if self.as_magnetic_field else Vector3Stamped()

@@ -1,5 +1,5 @@
 """``libhector_gazebo_ros_sonar.so``: a ray sensor's nearest reading as sensor_msgs/Range, in its frameId."""
-from ..core.range_sensor import HectorSonar
+from ..core.sensors.range_sensor import HectorSonar
 from .gazebo_ros_range import RangePublisher
 
 

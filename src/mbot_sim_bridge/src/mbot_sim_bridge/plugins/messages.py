@@ -10,8 +10,8 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from . import ros_time
 
 if TYPE_CHECKING:  # the drives use this module too, and need not import the camera's and IMU's modules
-    from ..core.camera import Intrinsics
-    from ..core.imu import ImuReading, ImuReadings
+    from ..core.cameras.camera import Intrinsics
+    from ..core.sensors.imu import ImuReading, ImuReadings
 
 
 def set_xyz(field, values: Sequence[float]):

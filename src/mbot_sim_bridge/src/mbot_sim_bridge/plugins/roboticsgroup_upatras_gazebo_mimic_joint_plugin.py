@@ -2,7 +2,7 @@
 parameter server, read by the core)."""
 import rospy
 
-from ..core.mimic_joint import MimicJoint
+from ..core.joints.mimic_joint import MimicJoint
 from . import RosPlugin
 
 

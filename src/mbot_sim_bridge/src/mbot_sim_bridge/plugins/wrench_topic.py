@@ -17,8 +17,7 @@ class WrenchTopic(RosPlugin):
                                                WrenchStamped)
 
     def update(self, now: float):
-        if not self.topics.listened(self.publisher):
-            self.idle(now)
+        if self.nobody_listens(now, self.publisher):
             return
         super().update(now)
         self.message.header.stamp = ros_time(now)

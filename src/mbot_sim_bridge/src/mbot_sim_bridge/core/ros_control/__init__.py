@@ -2,6 +2,7 @@
 gazebo_ros_control of Noetic). The ROS layer (``plugins/gazebo_ros_control.py``, ``plugins/ros_controllers.py``)
 adds services and topics.
 
+- ``gazebo_ros_control``: the ``libgazebo_ros_control.so`` plugin over all of them;
 - ``hardware_interface``: the interface names; ``transmissions``: the ``<transmission>`` parser;
   ``joint_limits``: limits from the URDF and the parameters; ``angles`` and ``control_toolbox`` (Pid);
 - ``robot_hw_sim``: the robot hardware simulation (DefaultRobotHWSim); ``controller_manager``;

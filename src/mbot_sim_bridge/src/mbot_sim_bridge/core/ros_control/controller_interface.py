@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, List, Optional, Sequence, Tuple
 
 from ..log import get_logger, warn_once
-from ..robot_model import RobotModel
+from ..description.robot_model import RobotModel
 from .hardware_interface import JOINT_STATE
 from .robot_hw_sim import DefaultRobotHWSim
 

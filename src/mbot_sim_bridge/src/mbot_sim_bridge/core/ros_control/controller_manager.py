@@ -205,10 +205,7 @@ class ControllerManager:
     def update(self, now: float, period: float, reset_controllers: bool = False):
         """Every running controller's update, then a pending switch, as ControllerManager::update."""
         if reset_controllers:
-            for loaded in self.controllers:
-                if loaded.state == "running":
-                    loaded.controller.stop_request(now)
-                    loaded.controller.start_request(now)
+            self.restart_running(now)
         for update in self._updates:
             update(now, period)
         request = self._switch_request
@@ -223,6 +220,13 @@ class ControllerManager:
                              if loaded.state == "running" and type(loaded.controller).update is not Controller.update]
             self._switch_request = None
             done.set()
+
+    def restart_running(self, now: float):
+        """Every running controller stopped and started again: it holds (or starts from) where the joints are."""
+        for loaded in self.controllers:
+            if loaded.state == "running":
+                loaded.controller.stop_request(now)
+                loaded.controller.start_request(now)
 
 
 def _join(namespace: str, name: str) -> str:

@@ -8,7 +8,7 @@ import operator
 from typing import List, NamedTuple, Optional
 
 from ..log import get_logger, warn_once
-from ..robot_model import RobotModel
+from ..description.robot_model import RobotModel
 from .controller_manager import ControllerInitError
 from .hardware_interface import VELOCITY
 from .controller_interface import Controller, param

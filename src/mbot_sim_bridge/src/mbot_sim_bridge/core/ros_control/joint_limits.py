@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from ..log import get_logger, warn_once
-from ..robot_model import Joint
+from ..description.robot_model import Joint
 
 _logger = get_logger(__name__)
 

@@ -5,7 +5,7 @@ The single-joint ones put a sample of their state into the ``outbox`` every tent
 upstream fills its control_msgs/JointControllerState (``state``) then; the ROS layer publishes it."""
 from typing import NamedTuple, Optional
 
-from ..robot_model import RobotModel
+from ..description.robot_model import RobotModel
 from .angles import position_error
 from .control_toolbox import Pid
 from .controller_manager import ControllerInitError

@@ -12,7 +12,7 @@ from typing import Dict, List, Optional, Sequence
 
 from ..errors import ConfigError
 from ..log import get_logger, info_once, warn_once
-from ..robot_model import RobotModel
+from ..description.robot_model import RobotModel
 from .angles import normalize_angle, position_error
 from .control_toolbox import Pid, clamp
 from .hardware_interface import (EFFORT, INTERFACE_TYPES, JOINT_STATE, MAX_JOINT_SPEED, POSITION,
@@ -343,6 +343,20 @@ class DefaultRobotHWSim:
         warn_once(_logger, f"{self.label}: joint '{joint.name}': {mode} command {value:g} is beyond the engine's "
                            f"{bound:g}; clamped")
         return math.copysign(bound, value)
+
+    def joints_set(self, positions: Dict[str, float]):
+        """set_model_configuration put joints at positions, at rest: read them as they are, and a position
+        joint's command is its new position, from the next step on, until a controller commands it (else it
+        would return to 0)."""
+        for name, position in positions.items():
+            joint = self.joints.get(name)
+            if joint is not None:
+                joint.position, joint.velocity = position, 0.0
+                if joint.interface == POSITION:
+                    joint.command = joint.previous_command = position
+                    if joint.motor == "position":
+                        joint.sent_loads, joint.sent_value = self.robot.loads, position
+                        self._set_motor(joint, "position", position)
 
     def forget_motors(self):
         """After a reset the engine's motors may have changed; send every setting again."""

@@ -1,0 +1,46 @@
+"""spawn_sdf_model's input -> a one-model SDF world the world loader reads.
+
+gazebo_ros accepts ``<sdf><model>`` (spawn_model -file/-param) and ``<sdf><world><include>`` (what
+spawn_model -database sends). The model is renamed to the requested name and placed at the requested pose
+composed with its own, as spawn_sdf_model does.
+"""
+from xml.etree import ElementTree
+
+from ..errors import ModelError
+from ..geometry import Pose, compose, rpy
+from ..xml_values import parse_xml, read_pose
+
+
+def _pose_text(pose: Pose) -> str:
+    return " ".join(f"{value:.9g}" for value in tuple(pose.position) + tuple(rpy(pose.orientation)))
+
+
+def _set_pose(element: ElementTree.Element, pose: Pose):
+    existing = element.find("pose")
+    if existing is None:
+        existing = ElementTree.SubElement(element, "pose")
+    existing.text = _pose_text(pose)
+
+
+def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
+    where = f"model '{name}'"
+    document = parse_xml(model_xml.encode(), where, ModelError)
+    root = document.root
+    if root.tag != "sdf":
+        raise ModelError(f"{where} is not SDF: its root element is <{root.tag}>, not <sdf>")
+    world = root.find("world")
+    entries = (world.findall("model") + world.findall("include")) if world is not None else root.findall("model")
+    if len(entries) != 1:
+        raise ModelError(f"{where}: expected exactly one <model> (or one <include> in a <world>), found {len(entries)}")
+    entry = entries[0]
+    if entry.tag == "model":
+        entry.set("name", name)
+    else:
+        name_element = entry.find("name")
+        if name_element is None:
+            name_element = ElementTree.SubElement(entry, "name")
+        name_element.text = name
+    _set_pose(entry, compose(pose, read_pose(entry.find("pose"), document)))
+    spawned = ElementTree.Element("sdf", version=root.get("version", "1.6"))
+    ElementTree.SubElement(spawned, "world", name="spawn").append(entry)
+    return ElementTree.tostring(spawned, encoding="unicode")

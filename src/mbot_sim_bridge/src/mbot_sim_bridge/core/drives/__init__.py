@@ -1,0 +1,1 @@
+"""The drive plugins: differential, holonomic (planar move), skid-steer and tricycle."""

@@ -1,0 +1,1 @@
+"""hector_gazebo_plugins: the sensor error model, IMU, GPS and magnetometer."""

@@ -1,0 +1,1 @@
+"""The joint plugins: the joint state publisher and the mimic joint."""
