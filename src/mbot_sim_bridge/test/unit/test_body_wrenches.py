@@ -122,6 +122,24 @@ def test_bad_requests_are_refused_and_change_nothing(tmp_path):
     sim.close()
 
 
+@pytest.mark.parametrize("start, duration", [(math.nan, 1.0), (math.inf, 1.0), (-math.inf, 1.0), (1e308, 1.0),
+                                             (0.0, math.nan), (0.0, math.inf), (0.0, -math.inf), (0.0, -1e308)])
+def test_a_start_time_or_duration_no_ros_time_holds_is_refused(tmp_path, start, duration):
+    """A start of 1e308 s overflowed the loop's count of steps to it; NaN or inf would never start or end."""
+    sim = world_simulation(tmp_path, CRATE)
+    with pytest.raises(ModelError, match=r"start_time and duration must be finite and at most 4\.29497e\+09 s"):
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (1, 0, 0), (0, 0, 0), start, duration)
+    assert not sim.wrenches.pending()
+
+
+def test_the_latest_ros_time_is_a_start_the_loop_waits_for(tmp_path):
+    sim = world_simulation(tmp_path, CRATE)
+    sim.apply_body_wrench("crate::link", "", (0, 0, 0), (1e3, 0, 0), (0, 0, 0), 2.0 ** 32 - 1e-9, -2.0 ** 31)
+    assert sim.wrenches.pending()
+    sim.step(50)
+    assert sim.wrenches.applied_to("crate", "link") == ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
 def test_f3d_on_a_link_lumped_away_is_refused(tmp_path):
     sim = world_simulation(tmp_path)
     with pytest.raises(ConfigError, match="bodyName: nowhere does not exist in model 'arm'"):

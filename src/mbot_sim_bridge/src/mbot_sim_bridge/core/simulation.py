@@ -173,9 +173,8 @@ class Simulation:
                           duration: float):
         """Schedule a wrench on link ``body`` ("model::link"), as gazebo_ros's apply_body_wrench; the request is
         checked and made a job by ``body_wrenches.requested_job`` (ModelError with upstream's message)."""
-        self.wrenches.add(requested_job(body, reference_frame, reference_point, force, torque,
-                                        max(start_time, self.sim_time), duration, self.link_names, self._link_pose,
-                                        self._entity_pose))
+        self.wrenches.add(requested_job(body, reference_frame, reference_point, force, torque, start_time, duration,
+                                        self.sim_time, self.link_names, self._link_pose, self._entity_pose))
 
     def clear_body_wrenches(self, body: str):
         model, _, link = body.partition("::")
