@@ -7,6 +7,7 @@ and it still takes requests.
 import math
 import os
 import subprocess
+import threading
 import time
 from xml.etree import ElementTree
 
@@ -163,6 +164,7 @@ def assert_refused(result, name, *expected):
     ({"wheelTorque": "-30"}, ("<wheelTorque>", "'-30'", ">= 0")),
     ({"wheelAcceleration": "-1.8"}, ("<wheelAcceleration>", "'-1.8'", ">= 0")),
     ({"wheelDiameter": "1e-300"}, ("<wheelDiameter>", "'1e-300'", ">= 0.001")),
+    ({"updateRate": "1e-308"}, ("<updateRate>", "'1e-308'", "<= 0 or >= 1e-06")),  # issue 39: the node died
 ])
 def test_bad_wheel_tags_refuse_the_spawn(env, bridge, tmp_path, mbot_urdf, tags, expected):
     result = spawn(env, tmp_path, "bad", with_drive_tags(mbot_urdf, **tags))
@@ -194,6 +196,25 @@ def test_set_model_state_refuses_nan_and_reset_repairs(env, bridge):
                    f"{reset} to put the mbot back on the floor")
         assert math.hypot(*model_pose(env, "good")[:2]) < 0.5
         assert_still_serving(env, bridge, drive=True)
+
+
+@pytest.mark.parametrize("field, expected", [
+    ("pose: {position: {x: 1.0e+300}}", "position.x = 1e+300 is outside ±100000"),  # said "position.x is inf"
+    ("twist: {angular: {z: 1.0e+300}}", "angular velocity.z = 1e+300 is outside ±10000"),  # said "velocity.x is nan"
+])
+def test_set_model_state_names_the_value_sent(env, bridge, field, expected):
+    response = call(env, "set_model_state", f"{{model_state: {{model_name: good, {field}}}}}")
+    assert response["success"] is False and expected in response["status_message"], response
+
+
+def test_a_quaternion_of_huge_components_is_normalised(env, bridge):
+    """Four components of 1e308 normalise to (0.5, 0.5, 0.5, 0.5), as gazebo_ros normalises (refused as NaN before)."""
+    spawn_z = model_pose(env, "good")[2]
+    response = call(env, "set_model_state", "{model_state: {model_name: good, pose: {position: {z: 1}, orientation: "
+                                            "{x: 1.0e+308, y: 1.0e+308, z: 1.0e+308, w: 1.0e+308}}}}")
+    assert response["success"] is True, response
+    call(env, "reset_world")
+    wait_until(lambda: abs(model_pose(env, "good")[2] - spawn_z) < 0.05, 30, "reset_world to put the mbot back")
 
 
 # -- 5: a missing mesh names the file, the link and the model ---------------------------------------------------
@@ -329,3 +350,98 @@ def test_set_model_state_with_an_overflowing_quaternion(env, bridge):
                                             "{w: 1.5e+154}}}}")
     assert response["success"] or "\n" not in response["status_message"], response
     assert all(math.isfinite(v) for v in model_pose(env, "good"))
+
+
+# -- issue 39: calls during long work, a description too big to read in the loop, more joints than PyBullet holds ---
+def test_calls_during_a_long_step_are_carried_out_and_answered_at_once(env, bridge, monkeypatch):
+    """The loop serves other calls between the batches of a step_simulation: each is carried out and answered
+    while the step goes on (before, they failed after 30 s with an empty text and ran afterwards); a second
+    step_simulation is refused at once with the reason."""
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])  # call_service sets it per call, in two threads
+    call(env, "pause_physics")
+    try:
+        started = time.monotonic()
+        assert call(env, "step_simulation", "{steps: 2000}")["success"]
+        steps = int(2000 * 20 / (time.monotonic() - started))  # about 20 s of the loop
+        answer = {}
+        stepper = threading.Thread(target=lambda: answer.update(
+            call_service(env, "/gazebo/step_simulation", f"{{steps: {steps}}}", 300)), daemon=True)
+        before = sim_time(env)
+        stepper.start()
+        wait_until(lambda: sim_time(env) > before, 10, "the step to start")
+        second = call(env, "step_simulation", "{steps: 1}")
+        assert not second["success"] and "another step_simulation is under way" in second["status_message"], second
+        box = ("<sdf version='1.6'><model name='box'><static>true</static><pose>5 5 0.5 0 0 0</pose><link name='l'>"
+               "<collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link></model>"
+               "</sdf>")
+        assert call(env, "spawn_sdf_model", f'{{model_name: box, model_xml: "{box}"}}')["success"]
+        assert "box" in model_names(env) and all(math.isfinite(v) for v in model_pose(env, "good"))
+        assert call(env, "delete_model", "{model_name: box}")["success"]
+        assert stepper.is_alive(), "the step ended before the calls were made; make it longer"
+        stepper.join(300)
+        assert answer["success"] and answer["sim_time"] >= before + steps * 0.001 - 1e-6, answer
+    finally:
+        call(env, "unpause_physics")
+    assert_still_serving(env, bridge)
+
+
+def test_a_50_mb_description_does_not_stop_the_clock(env, bridge, mbot_urdf, monkeypatch):
+    """A description of 700,000 <gazebo reference> blocks (100,000 unless MBOT_FULL_SWEEP=1: the suite's time) is
+    read in the service's thread, so /clock goes on while it loads (before, it stopped for 25 s and then
+    jumped)."""
+    import rospy
+    from gazebo_msgs.srv import SpawnModel, SpawnModelRequest
+
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
+    block = '<gazebo reference="base_link"><material>Gazebo/Blue</material></gazebo>'
+    blocks = 720000 if os.environ.get("MBOT_FULL_SWEEP") else 100000
+    request = SpawnModelRequest(model_name="big", model_xml=mbot_urdf.replace("</robot>", block * blocks + "</robot>"))
+    request.initial_pose.position.x = -3.0
+    answer = []
+    spawner = threading.Thread(target=lambda: answer.append(
+        rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)(request)), daemon=True)
+    spawner.start()
+    longest, last, times = 0.0, time.monotonic(), [sim_time(env)]
+    while spawner.is_alive():
+        times.append(sim_time(env))
+        now = time.monotonic()
+        if times[-1] > times[-2]:
+            longest, last = max(longest, now - last), now
+        time.sleep(0.2)
+    spawner.join()
+    assert answer and answer[0].success, answer
+    print(f"figure: /clock while a {len(request.model_xml) / 1e6:.0f} MB description loaded: longest stall "
+          f"{longest:.1f} s")
+    assert longest < 2.0  # 3.3 s at 100,000 blocks before, 0.5 s after (1.1 s at 720,000)
+    assert call(env, "delete_model", "{model_name: big}")["success"]
+    assert_still_serving(env, bridge)
+
+
+@pytest.mark.parametrize("inertial, expected", [
+    ("<mass>1e300</mass>", "<mass>: 1e+300 is outside the valid range >= 1e-06 and <= 1e+09"),
+    ("<mass>1</mass><inertia><ixx>0</ixx><iyy>1</iyy><izz>1</izz></inertia>", "<inertia> has principal moments 0"),
+])
+def test_sdf_inertials_that_turned_the_model_nan_are_refused(env, bridge, tmp_path, inertial, expected):
+    """A mass of 1e300 was accepted, and the model's pose read NaN until it was deleted."""
+    sdf = NAN_POSE_SDF.replace("nan 0 1", "0 3 1").replace("<link name='l'>", f"<link name='l'><inertial>{inertial}"
+                                                                           "</inertial>")
+    assert "<inertial>" in sdf
+    result = spawn(env, tmp_path, "heavy", sdf, kind="-sdf")
+    assert_refused(result, "heavy", "link 'l' of model 'heavy'", expected)
+    assert "heavy" not in model_names(env)
+    assert_still_serving(env, bridge)
+
+
+def test_more_joints_than_a_pybullet_body_holds_are_refused_and_the_bridge_carries_on(env, bridge, tmp_path):
+    links = ['<link name="l0"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" '
+             'ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+             '</link>']
+    for index in range(1, 1001):
+        links.append(f'<link name="l{index}"><inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" '
+                     f'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j{index}" '
+                     f'type="revolute"><parent link="l{index - 1}"/><child link="l{index}"/><axis xyz="0 0 1"/>'
+                     f'<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>')
+    result = spawn(env, tmp_path, "chain", '<robot name="chain">' + "\n".join(links) + "</robot>")
+    assert_refused(result, "chain", "1000 movable joints; a PyBullet body holds at most 127")
+    assert "chain" not in model_names(env)
+    assert_still_serving(env, bridge)

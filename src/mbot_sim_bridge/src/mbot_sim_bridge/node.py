@@ -9,7 +9,7 @@ import queue
 import sys
 import threading
 import time
-from concurrent.futures import Future
+from concurrent.futures import Future, TimeoutError as FutureTimeout
 from typing import Callable, Optional
 
 import pybullet
@@ -36,6 +36,10 @@ from .services import GazeboRosApi
 DEFAULT_CLOCK_FREQUENCY = 100.0
 # How far ahead of the wall clock the loop may run before it sleeps, at a real-time factor > 0.
 _PACING_SLACK_SECONDS = 0.002
+
+
+class LoopBusy(BridgeError):
+    """A request the loop did not take within its time: refused, and never carried out."""
 
 
 def _bool_param(name: str, default: bool) -> bool:
@@ -83,6 +87,7 @@ class SimBridgeNode:
         self.clock_timer = UpdateTimer(clock_frequency)
         self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
         self._requests: "queue.Queue[tuple]" = queue.Queue()
+        self.steps_left = 0  # of the step_simulation under way
         self._stop = threading.Event()  # set by run(): a stop asked for while a step request runs
         self._pace_wall_start = self._pace_sim_start = 0.0
         self._last_clock = -1.0
@@ -100,10 +105,19 @@ class SimBridgeNode:
 
     # -- called from ROS threads -------------------------------------------------------------------------
     def call_in_loop(self, function: Callable, timeout: Optional[float] = 30.0):
-        """Run ``function`` in the loop's thread (the only one that touches the engine) and return its result."""
+        """Run ``function`` in the loop's thread (the only one that touches the engine) and return its result.
+        The loop takes requests between its batches of steps, during a step_simulation too; one it has not taken
+        within ``timeout`` (a spawn of its own can take that long) is withdrawn and refused with LoopBusy, so a
+        call never fails and is carried out all the same."""
         future: Future = Future()
         self._requests.put((function, future))
-        return future.result(timeout)
+        try:
+            return future.result(timeout)
+        except FutureTimeout:
+            if future.cancel():
+                raise LoopBusy(f"the simulator did not take the request within {timeout:g} s (its loop was busy with "
+                               "another request); it was not carried out") from None
+            return future.result()  # taken meanwhile: answered once carried out
 
     # -- loop thread --------------------------------------------------------------------------------------
     def set_paused(self, paused: bool):
@@ -120,10 +134,16 @@ class SimBridgeNode:
 
     def step(self, count: int):
         """Exactly ``count`` physics steps, outputs and /clock included (lockstep); /clock ends at the last step,
-        so the nodes' ROS time is the sim time the answer reports."""
-        while count > 0 and not self._stop.is_set():  # Ctrl-C ends a long request too
-            count -= self.sim.advance(count, self._before_updates)
-            self.publishing.flush(wait=True)
+        so the nodes' ROS time is the sim time the answer reports. Other requests are served between the
+        batches, so a long step holds up no call."""
+        self.steps_left = count
+        try:
+            while self.steps_left > 0 and not self._stop.is_set():  # Ctrl-C ends a long request too
+                self.steps_left -= self.sim.advance(self.steps_left, self._before_updates)
+                self.publishing.flush(wait=True)
+                self._serve_requests(block=False)
+        finally:
+            self.steps_left = 0
         if self._last_clock < self.sim.sim_time:
             self._publish_clock(self.sim.sim_time)
         self.publishing.sync()

@@ -21,7 +21,7 @@ from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
-from .core.engine import check_state
+from .core.engine import check_model_name, check_state
 from .core.errors import BridgeError, ModelError
 from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
 from .gazebo_paths import model_path
@@ -47,9 +47,12 @@ SET_MODEL_CONFIGURATION_SUCCESS = "SetModelConfiguration: success"
 def _pose_from_message(message: PoseMessage) -> Pose:
     """The pose with its quaternion normalised, as gazebo_ros does; a zero quaternion is the identity."""
     q = message.orientation
-    norm = math.hypot(q.x, q.y, q.z, q.w)  # hypot, not a sum of squares: no overflow for huge components
+    # Scaled by the largest component first: four components of 1e308 normalise, and hypot does not overflow.
+    largest = max(abs(q.x), abs(q.y), abs(q.z), abs(q.w))
+    scaled = (q.x, q.y, q.z, q.w) if largest in (0.0, math.inf) else tuple(v / largest for v in (q.x, q.y, q.z, q.w))
+    norm = math.hypot(*scaled)
     # A non-finite component stays non-finite here, and check_state refuses it by name.
-    orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else (q.x / norm, q.y / norm, q.z / norm, q.w / norm)
+    orientation = (0.0, 0.0, 0.0, 1.0) if norm == 0 else tuple(v / norm for v in scaled)
     return Pose((message.position.x, message.position.y, message.position.z), orientation)
 
 
@@ -106,26 +109,33 @@ class GazeboRosApi:
         try:
             return self.node.call_in_loop(action, timeout)
         except BridgeError as error:
-            rospy.logerr(str(error))
-            return response_type(success=False, status_message=str(error))
+            return _refused(response_type, error)
 
     # -- spawn and delete -------------------------------------------------------------------------------------
     def _new_model_pose(self, request) -> Pose:
         """The world pose a SpawnModel request asks for, once its name is known to be free."""
         if request.model_name in self.sim.model_names():
             raise ModelError(f"SpawnModel: Failure - entity already exists: {request.model_name}")
-        pose = compose(self._reference_pose(request.reference_frame), _pose_from_message(request.initial_pose))
+        check_model_name("SpawnModel", request.model_name)
+        requested = _pose_from_message(request.initial_pose)
+        # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
+        check_state(f"SpawnModel: model '{request.model_name}'", requested)
+        pose = compose(self._reference_pose(request.reference_frame), requested)
         check_state(f"SpawnModel: model '{request.model_name}'", pose)
         return pose
 
     def _spawn_urdf_model(self, request):
-        def spawn():
-            name = request.model_name
-            pose = self._new_model_pose(request)
+        name, namespace = request.model_name, request.robot_namespace
+        try:
+            # Read in this service thread, not the loop's: a description of 50 MB stopped /clock for 25 s.
             model = parse_robot(resolve_package_uris(request.model_xml), f"model '{name}'")
-            namespace = request.robot_namespace
-            if namespace:
-                _inject_namespace(model, namespace)
+        except BridgeError as error:
+            return _refused(SpawnModelResponse, error)
+        if namespace:
+            _inject_namespace(model, namespace)
+
+        def spawn():
+            pose = self._new_model_pose(request)
             self.sim.spawn_robot(model, name, pose, namespace or "/")
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")
         return self._guarded(SpawnModelResponse, spawn)
@@ -162,6 +172,9 @@ class GazeboRosApi:
                           f"{LOCKSTEP_DRAIN_SECONDS:.0f} s; stepping anyway")
 
         def step():
+            if self.node.steps_left:
+                raise ModelError(f"StepSimulation: another step_simulation is under way ({self.node.steps_left} steps "
+                                 "left); call again once it has answered")
             if not self.sim.paused:
                 raise ModelError("StepSimulation: the simulation is running; pause it (or start with "
                                  "lockstep:=true) to step it")
@@ -202,10 +215,13 @@ class GazeboRosApi:
 
         def set_state():
             reference = self._reference_pose(state.reference_frame)
-            pose = compose(reference, _pose_from_message(state.pose))
-            twist = state.twist
-            linear = rotate(reference.orientation, (twist.linear.x, twist.linear.y, twist.linear.z))
-            angular = rotate(reference.orientation, (twist.angular.x, twist.angular.y, twist.angular.z))
+            requested, twist = _pose_from_message(state.pose), state.twist
+            linear, angular = ((twist.linear.x, twist.linear.y, twist.linear.z),
+                               (twist.angular.x, twist.angular.y, twist.angular.z))
+            # Checked as sent too: transformed, 1e300 would turn inf and NaN, and on other axes.
+            check_state(f"SetModelState: model '{state.model_name}'", requested, linear, angular)
+            pose = compose(reference, requested)
+            linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
             self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
@@ -276,6 +292,12 @@ class GazeboRosApi:
             state.pose, state.twist = _pose_to_message(pose), _twist_message(linear, angular)
             return response
         return self._guarded(GetLinkStateResponse, get)
+
+
+def _refused(response_type, error: BridgeError):
+    """A service's answer to a request refused with ``error``: success false and its one line."""
+    rospy.logerr(str(error))
+    return response_type(success=False, status_message=str(error))
 
 
 def _inject_namespace(model, namespace: str):

@@ -66,3 +66,20 @@ def test_the_gripper_reaches_an_empty_goal_stalls_on_a_box_and_its_mimic_finger_
     assert end.position == pytest.approx(0.02, abs=0.002)
     (left, _, _), (right, _, _) = spawned.robot.joint_state([leader, follower])
     assert abs(left - right) < 0.001
+
+
+@pytest.mark.parametrize("position", [0.05, -0.01, 1e300, -5.0])
+def test_a_gripper_goal_past_the_fingers_travel_ends_stalled_on_the_stop(position):
+    """Upstream's semantics: the finger rests on its limit (0 to 0.04 m) and the goal is aborted as stalled after
+    stall_timeout; before, the effort gripper chattered at the limit (up to 0.4 m/s) and never ended (the position
+    gripper's command is saturated to the limit, and it stalled already)."""
+    sim, spawned, _, gripper = arm("effort")
+    try:
+        assert gripper.accept_goal(GripperGoal(position, 30.0))
+        end = run_until_ended(sim, gripper, seconds=3.0)
+        assert (end.status, end.reached_goal, end.stalled) == (ABORTED, False, True)
+        assert end.position == pytest.approx(0.04 if position > 0 else 0.0, abs=2e-4)
+        (_, speed, _), = spawned.robot.joint_state(["left_finger_joint"])
+        assert abs(speed) < 1e-3
+    finally:
+        sim.close()

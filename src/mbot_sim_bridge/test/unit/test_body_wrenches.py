@@ -61,6 +61,22 @@ def test_a_crate_held_by_its_weight_hovers_until_the_wrench_ends_or_is_cleared(t
     sim.close()
 
 
+@pytest.mark.parametrize("simulation", [False, True])
+def test_a_reset_ends_every_wrench_so_the_world_is_as_spawned(tmp_path, simulation):
+    """Resets repair what service calls left (the README): a wrench "until cleared" ends with them too."""
+    sim = world_simulation(tmp_path, CRATE)
+    try:
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (0, 0, 3 * CRATE_MASS * GRAVITY), (0, 0, 0), 0.0, -1.0)
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (0, 0, 0), (0, 0, 1), 5.0, 1.0)
+        sim.step(200)
+        sim.reset(simulation)
+        assert not sim.wrenches.pending()
+        sim.step(1000)
+        assert crate_height(sim) == pytest.approx(0.15, abs=1e-3)  # fell onto the ground and rests there
+    finally:
+        sim.close()
+
+
 def test_f3d_reports_the_applied_force_and_nothing_without_one(tmp_path):
     sim = world_simulation(tmp_path)
     spawned = sim.spawn_robot(parse_robot(ARM.format(body="plate"), "model 'arm'"), "arm")
@@ -104,6 +120,24 @@ def test_bad_requests_are_refused_and_change_nothing(tmp_path):
             sim.apply_body_wrench("crate::link", "", (0, 0, 0), force, (0, 0, 0), 0.0, 1.0)
     assert not sim.wrenches.pending()
     sim.close()
+
+
+@pytest.mark.parametrize("start, duration", [(math.nan, 1.0), (math.inf, 1.0), (-math.inf, 1.0), (1e308, 1.0),
+                                             (0.0, math.nan), (0.0, math.inf), (0.0, -math.inf), (0.0, -1e308)])
+def test_a_start_time_or_duration_no_ros_time_holds_is_refused(tmp_path, start, duration):
+    """A start of 1e308 s overflowed the loop's count of steps to it; NaN or inf would never start or end."""
+    sim = world_simulation(tmp_path, CRATE)
+    with pytest.raises(ModelError, match=r"start_time and duration must be finite and at most 4\.29497e\+09 s"):
+        sim.apply_body_wrench("crate::link", "", (0, 0, 0), (1, 0, 0), (0, 0, 0), start, duration)
+    assert not sim.wrenches.pending()
+
+
+def test_the_latest_ros_time_is_a_start_the_loop_waits_for(tmp_path):
+    sim = world_simulation(tmp_path, CRATE)
+    sim.apply_body_wrench("crate::link", "", (0, 0, 0), (1e3, 0, 0), (0, 0, 0), 2.0 ** 32 - 1e-9, -2.0 ** 31)
+    assert sim.wrenches.pending()
+    sim.step(50)
+    assert sim.wrenches.applied_to("crate", "link") == ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 def test_f3d_on_a_link_lumped_away_is_refused(tmp_path):

@@ -95,6 +95,11 @@ def test_bad_camera_values_are_refused_with_the_tag(kinect_urdf, tmp_path):
         bad = kinect_urdf.replace("<width>640</width>", "<width>-3</width>")
         with pytest.raises(ConfigError, match="camera/image/width"):
             sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
+        bad = kinect_urdf.replace("<width>640</width>", "<width>8192</width>").replace("<height>480</height>",
+                                                                                       "<height>8192</height>")
+        with pytest.raises(ConfigError, match=r"<image> 8192 x 8192 is 67,108,864 pixels; a camera renders at most "
+                                              r"4,194,304 \(2048 x 2048\) per frame"):
+            sim.spawn_robot(parse_robot(bad, "model 'mbot'"), "mbot")
         assert "mbot" not in sim.model_names()
     finally:
         sim.close()

@@ -8,6 +8,7 @@ import copy
 import logging
 import math
 import os
+import re
 import resource
 import signal
 import tempfile
@@ -17,7 +18,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
@@ -29,6 +30,7 @@ from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
+from mbot_sim_bridge.robot_description import expand_xacro
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORLDS = os.path.join(HERE, "..", "..", "..", "..", "worlds")
@@ -41,10 +43,18 @@ FUZZ = settings(derandomize=True, deadline=None, database=None, print_blob=True,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                        HealthCheck.function_scoped_fixture])
 
+# Finite but extreme: the smallest normal and subnormal doubles and the largest magnitudes.
+EXTREMES = ("1e-308", "5e-324", "-5e-324", "1e308", "-1e308")
 BAD_NUMBERS = ("nan", "NaN", "-nan", "inf", "-inf", "1e309", "-1e309", "1e300", "-1e300", "1e-300", "0", "-0",
-               "-1", "-1000", "1e5", "1e12", "99999999999999999999", "0x10", "abc", "", " ", "1 2 3", "true")
+               "-1", "-1000", "1e5", "1e12", "99999999999999999999", "0x10", "abc", "", " ", "1 2 3",
+               "true") + EXTREMES
 BAD_VECTORS = ("nan 0 0", "0 0 inf", "1e300 0 0", "0 0", "1 2 3 4 5 6 7", "-1 -1 -1", "0 0 0", "a b c",
-               "1e-300 1e-300 1e-300", "nan 0 1 0 0 0", "0 0 0 0 0 1e300")
+               "1e-300 1e-300 1e-300", "nan 0 1 0 0 0", "0 0 0 0 0 1e300", "1e-308 0 0", "5e-324 0 0",
+               "0 5e-324 5e-324", "1e308 1e308 1e308")
+# MBOT_FULL_SWEEP=1 runs every case of the sweeps below; otherwise a seeded sample, for the suite's time.
+FULL_SWEEP = bool(os.environ.get("MBOT_FULL_SWEEP"))
+# A dynamic crate beside each case; it must not move by more than this (m).
+BYSTANDER_TOLERANCE = 1e-4
 MESHES = ("/nonexistent/mesh.stl", "/dev/null", "/tmp", "meshes/relative.stl", "package://nowhere/m.stl",
           "http://example.invalid/m.stl", "file:///nonexistent.dae", "model://nowhere/mesh.dae")
 
@@ -308,8 +318,19 @@ def mbot_model(mbot_urdf):
     return parse_robot(mbot_urdf, "model 'mbot'")
 
 
+EXTREME_NUMBERS = st.sampled_from(tuple(float(text) for text in EXTREMES) + (0.0, -1.0, 1.0))
+INERTIAL_SDF = ("<sdf version='1.6'><model name='m'><link name='l'><inertial><mass>{}</mass><inertia><ixx>{}</ixx>"
+                "<iyy>{}</iyy><izz>{}</izz></inertia></inertial><collision name='c'><geometry><box><size>0.5 0.5 0.5"
+                "</size></box></geometry></collision></link></model></sdf>")
+
 REQUESTS = st.one_of(
     st.tuples(st.just("set_model_state"), NAMES, VECTOR, QUATERNION, VECTOR, VECTOR),
+    st.tuples(st.just("spawn_sdf"), st.just("crate"), st.just((3.0, 0.0, 0.3)), st.just((0.0, 0.0, 0.0, 1.0)),
+              st.tuples(EXTREME_NUMBERS, EXTREME_NUMBERS, EXTREME_NUMBERS, EXTREME_NUMBERS).map(
+                  lambda values: INERTIAL_SDF.format(*values))),
+    st.tuples(st.just("step"), st.sampled_from((1, 100, 2000))),
+    st.tuples(st.just("wrench"), st.sampled_from(("mbot::base_footprint", "crate::l", "nowhere::l")), VECTOR,
+              EXTREME_NUMBERS, EXTREME_NUMBERS),
     st.tuples(st.just("spawn_robot"), NAMES, VECTOR, QUATERNION),
     st.tuples(st.just("spawn_sdf"), NAMES, VECTOR, QUATERNION,
               st.sampled_from(("<sdf version='1.6'><model name='m'><link name='l'><collision name='c'><geometry>"
@@ -339,6 +360,11 @@ def _apply(sim, request, mbot_urdf):
             sim.add_world(parse_world(world_file.name))
     elif name == "delete":
         sim.delete(request[1])
+    elif name == "step":
+        sim.step(request[1])
+    elif name == "wrench":
+        _, body, force, start, duration = request
+        sim.apply_body_wrench(body, "", (0.0, 0.0, 0.0), force, (0.0, 0.0, 0.0), start, duration)
     elif name == "command":
         for spawned in sim.models.values():
             for plugin in spawned.plugins:
@@ -350,6 +376,8 @@ def _apply(sim, request, mbot_urdf):
 
 @settings(FUZZ, max_examples=150)
 @given(requests=st.lists(REQUESTS, min_size=1, max_size=4))
+# Found: a wrench starting at 1e308 s overflowed the loop's count of steps to its start.
+@example(requests=[("wrench", "mbot::base_footprint", (1.0, 0.0, 0.0), 1e308, 1.0), ("step", 100)])
 def test_garbage_requests(requests, mbot_model, mbot_urdf):
     """A fresh world with the mbot for each sequence, so that a failure shrinks to the requests that made it."""
     sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS)
@@ -435,3 +463,180 @@ def test_a_bad_visual_is_left_out(laser_mbot_urdf, simulation, caplog):
         assert spawned.plugins
     finally:
         simulation.delete("seen")
+
+
+# -- extreme finite values in every numeric tag of every plugin and sensor the test robots carry --------------------
+def host_robots(laser_mbot_urdf):
+    """Robots that carry between them every emulated plugin but gazebo_ros_control (its one number, controlPeriod,
+    is a period() like the hector one's): their descriptions by name."""
+    from plugin_robots import (HOLONOMIC_XACRO, MIMIC_GRIPPER, MIMIC_PLUGIN_BLOCK, SKID_XACRO, STEREO_XACRO,
+                               TRICYCLE_XACRO, VELODYNE_STAND)
+    from sensor_fixtures import course_urdf
+    from test_new_plugin_inputs import SENSOR_ROBOTS, VLP16_MACRO
+    directory = tempfile.mkdtemp(prefix="mbot_fuzz_hosts_")
+    stand = os.path.join(directory, "stand.urdf.xacro")
+    with open(stand, "w") as stand_file:
+        stand_file.write(VELODYNE_STAND.format(macro=VLP16_MACRO, noise=0.008, organize="false"))
+    def small_images(urdf):  # a case renders a dozen frames: at 1280 x 720 they outlast the watchdog
+        return re.sub(r"<height>\d+</height>", "<height>48</height>",
+                      re.sub(r"<width>\d+</width>", "<width>64</width>", urdf))
+    hosts = {"laser mbot": laser_mbot_urdf, "camera mbot": small_images(course_urdf("mbot_with_camera_gazebo")),
+             "kinect mbot": small_images(course_urdf("mbot_with_kinect_gazebo")),
+             "planar": expand_xacro(HOLONOMIC_XACRO),
+             "skid": expand_xacro(SKID_XACRO),
+             "tricycle": expand_xacro(TRICYCLE_XACRO),
+             "stereo head": small_images(expand_xacro(STEREO_XACRO, rate="50")),
+             # 40 of the VLP-16's 440 columns: at an extreme update_rate it scans every step.
+             "velodyne": expand_xacro(stand).replace("<samples>440</samples>", "<samples>40</samples>"),
+             "gripper": MIMIC_GRIPPER.format(mimic="", plugin=MIMIC_PLUGIN_BLOCK.format(extra="")), **SENSOR_ROBOTS}
+    os.unlink(stand)
+    os.rmdir(directory)
+    return hosts
+
+
+def numeric_tag_cases(hosts):
+    """(host, plugin index, tag, on the sensor) for every int or float tag of every plugin's and sensor's table."""
+    cases = []
+    for host, urdf in hosts.items():
+        root = ET.fromstring(urdf)
+        parents = _parents(root)
+        for index, plugin in enumerate(root.iter("plugin")):
+            plugin_class = CORE_PLUGINS.get(plugin.get("filename", ""))
+            if plugin_class is None:
+                continue
+            on_sensor = parents[plugin].tag == "sensor"
+            for params, sensor_side in ((plugin_class.PARAMS, False), (plugin_class.SENSOR_PARAMS, True)):
+                cases += [(host, index, param.tag, sensor_side) for param in params
+                          if param.kind in (int, float) and (on_sensor or not sensor_side)]
+    return cases
+
+
+@pytest.fixture(scope="module")
+def tag_cases(laser_mbot_urdf):
+    hosts = host_robots(laser_mbot_urdf)
+    return hosts, numeric_tag_cases(hosts)
+
+
+def with_tag(urdf, index, tag, on_sensor, text):
+    root = ET.fromstring(urdf)
+    plugin = list(root.iter("plugin"))[index]
+    element = _parents(root)[plugin] if on_sensor else plugin
+    for part in tag.split("/"):
+        child = element.find(part)
+        element = child if child is not None else ET.SubElement(element, part)
+    element.text = text
+    return ET.tostring(root, encoding="unicode")
+
+
+CRATE = ("<robot name='crate'><link name='crate'><inertial><mass value='1'/><inertia ixx='0.01' iyy='0.01' "
+         "izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial><collision><geometry><box size='0.3 0.3 0.3'/></geometry>"
+         "</collision></link></robot>")
+
+
+def spawn_beside_a_crate(kind, urdf, steps=100):
+    """Spawn ``urdf`` 3 m from a settled crate and step: loaded (finite, no plugin failed, the crate still) or
+    refused with one line."""
+    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS)
+    try:
+        sim.spawn_robot(parse_robot(CRATE, "model 'crate'"), "crate", Pose((3.0, 3.0, 0.15), (0.0, 0.0, 0.0, 1.0)))
+        sim.step(100)
+        resting = sim.engine.model_pose("crate").position
+        try:
+            with watchdog():
+                sim.spawn_robot(parse_robot(urdf, "model 'fuzz'"), "fuzz")
+        except BridgeError as error:
+            assert "fuzz" not in sim.model_names(), "a refused model was left behind"
+            refused(kind, error)
+            return
+        with watchdog():
+            step_and_check(sim, kind)
+            sim.step(steps)
+            assert_finite_state(sim, kind)
+            moved = math.dist(sim.engine.model_pose("crate").position, resting)
+            assert moved < BYSTANDER_TOLERANCE, f"{kind}: the crate moved {moved * 1000:.3f} mm"
+            sim.reset(simulation=False)
+            sim.step(10)
+            assert_finite_state(sim, f"{kind} after reset_world")
+        tally(kind, "loaded")
+    finally:
+        sim.close()
+
+
+def check_extreme_tag(hosts, case, text):
+    host, index, tag, on_sensor = case
+    urdf = with_tag(hosts[host], index, tag, on_sensor, text)
+    try:
+        spawn_beside_a_crate("extreme tag values", urdf)
+    except AssertionError as error:
+        raise AssertionError(f"{host}, plugin {index}, <{tag}> = {text}: {error}") from None
+
+
+@settings(FUZZ, max_examples=20)
+@given(data=st.data())
+def test_extreme_finite_values_in_every_numeric_tag(data, tag_cases):
+    hosts, cases = tag_cases
+    check_extreme_tag(hosts, data.draw(st.sampled_from(cases)), data.draw(st.sampled_from(EXTREMES)))
+
+
+@pytest.mark.skipif(not FULL_SWEEP, reason="the full sweep runs with MBOT_FULL_SWEEP=1")
+def test_extreme_finite_values_in_every_numeric_tag_full_sweep(tag_cases):
+    hosts, cases = tag_cases
+    for case in cases:
+        for text in EXTREMES:
+            check_extreme_tag(hosts, case, text)
+
+
+# -- link counts up to 1000 -----------------------------------------------------------------------------------------
+LINK_COUNTS = (1, 2, 64, 127, 128, 129, 500, 1000)
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
+
+
+def chain(links, joint_type):
+    parts = ["<robot name='chain'><link name='l0'><inertial><mass value='1'/><inertia ixx='0.01' iyy='0.01' "
+             "izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial><collision><geometry><box size='0.1 0.1 0.1'/>"
+             "</geometry></collision></link>"]
+    for index in range(1, links):
+        parts.append(f"<link name='l{index}'><inertial><mass value='0.01'/><inertia ixx='1e-4' iyy='1e-4' "
+                     f"izz='1e-4' ixy='0' ixz='0' iyz='0'/></inertial></link><joint name='j{index}' "
+                     f"type='{joint_type}'><parent link='l{index - 1}'/><child link='l{index}'/>"
+                     f"<origin xyz='0 0 0.001'/><axis xyz='0 0 1'/>"
+                     f"<limit lower='-0.1' upper='0.1' effort='1' velocity='1'/></joint>")
+    return "\n".join(parts) + "</robot>"
+
+
+@settings(FUZZ, max_examples=4)
+@given(links=st.sampled_from(LINK_COUNTS), joint_type=st.sampled_from(JOINT_TYPES))
+def test_link_counts_up_to_1000(links, joint_type):
+    spawn_beside_a_crate("link counts", chain(links, joint_type), steps=20)
+
+
+@pytest.mark.skipif(not FULL_SWEEP, reason="the full sweep runs with MBOT_FULL_SWEEP=1")
+def test_link_counts_up_to_1000_full_sweep():
+    for links in LINK_COUNTS:
+        for joint_type in JOINT_TYPES:
+            spawn_beside_a_crate("link counts", chain(links, joint_type), steps=20)
+
+
+# -- gripper goals at and past the finger's limits ----------------------------------------------------------------
+GRIPPER_GOALS = [(position, effort) for position in (0.0, 0.04, 0.04 + 1e-9, 0.05, -0.01, 5e-324, 1e308, -1e308)
+                 for effort in (30.0, 0.0, 5e-324, 1e308)]
+
+
+def test_gripper_goals_at_and_past_the_limits_all_end():
+    """Each goal ends (succeeded, or aborted as stalled) within 3 s of sim time or is refused; the arm stays finite."""
+    from ros_control_fixtures import run_until_ended
+    from test_arm import arm
+
+    from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
+    sim, spawned, _, gripper = arm("effort")
+    goals = GRIPPER_GOALS if FULL_SWEEP else GRIPPER_GOALS[::7]
+    try:
+        for position, effort in goals:
+            if not gripper.accept_goal(GripperGoal(position, effort)):
+                tally("gripper goals", "refused")
+                continue
+            end = run_until_ended(sim, gripper, seconds=3.0)
+            tally("gripper goals", f"{end.status}{' stalled' if end.stalled else ''}")
+            assert_finite_state(sim, f"gripper goal {position}, {effort}")
+    finally:
+        sim.close()

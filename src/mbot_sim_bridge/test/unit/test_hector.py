@@ -108,6 +108,19 @@ def test_the_fix_at_the_spawn_point_is_the_reference(tmp_path):
     assert gps.timer.period == pytest.approx(1 / 40)
 
 
+def test_the_longitude_stays_a_longitude_at_the_pole(tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        urdf = HECTOR_ROBOT.format(heading=0.0, imu="", gps="").replace("<referenceLatitude>49.9<",
+                                                                        "<referenceLatitude>90<")
+        gps = plugin_of(sim.spawn_robot(parse_robot(urdf, "model 'box'"), "box"), HectorGps)
+        latitude, longitude, _ = gps.geodetic((0.0, 1.0, 0.0))
+        assert latitude == 90.0 and -180.0 <= longitude < 180.0  # was -8,496,471 degrees a metre from the pole
+        assert gps.geodetic((0.0, 0.0, 0.0))[1] == pytest.approx(8.9)
+    finally:
+        sim.close()
+
+
 def test_the_drift_is_a_gauss_markov_process_that_reruns_identically():
     model = SensorModel(0.1, 0.5, 1.0, 0.0, 1.0, np.random.default_rng(3))
     again = SensorModel(0.1, 0.5, 1.0, 0.0, 1.0, np.random.default_rng(3))

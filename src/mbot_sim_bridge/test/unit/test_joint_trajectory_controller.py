@@ -89,7 +89,13 @@ def test_a_second_goal_preempts_the_first_and_unknown_joints_are_refused():
     assert controller.accept_goal(second)[0]
     assert controller.ended.pop(0).goal is first and not controller.ended
     assert controller.accept_goal(TrajectoryGoal(JointTrajectory(["shoulder", "wrist"], [
-        TrajectoryPoint([0.0, 0.0], time_from_start=1.0)]))) == (False, INVALID_JOINTS, "")
+        TrajectoryPoint([0.0, 0.0], time_from_start=1.0)]))) == (False, INVALID_JOINTS, (
+            "Joints on incoming goal don't match the controller joints: got [shoulder, wrist], the controller has "
+            "[shoulder, elbow]"))
+    # One joint named twice is refused too (upstream moved it as the last of its entries said and SUCCEEDED).
+    twice = controller.accept_goal(TrajectoryGoal(JointTrajectory(["shoulder", "shoulder"], [
+        TrajectoryPoint([0.0, 0.3], time_from_start=1.0)])))
+    assert twice[:2] == (False, INVALID_JOINTS) and "got [shoulder, shoulder]" in twice[2]
     refused = controller.accept_goal(goal([(1.0, [0.0, 0.0]), (1.0, [0.1, 0.1])]))
     assert refused[:2] == (False, INVALID_GOAL) and "strictly increasing" in refused[2]
     assert controller.accept_goal(goal([(1.0, [math.nan, 0.0])]))[:2] == (False, INVALID_GOAL)

@@ -77,3 +77,23 @@ def test_pid_effort_is_clamped_to_max_effort(tmp_path):
     assert abs(effort) <= 0.5 + 1e-9
     assert np.isfinite(effort)
     sim.close()
+
+
+@pytest.mark.parametrize("multiplier", [1e6, -1e6])
+def test_a_huge_multiplier_keeps_the_follower_within_its_travel_and_reset_world_settles_it(tmp_path, multiplier):
+    """The follower's target is held to its limits: with a multiplier of 1e6 the gripper flew 11.7 m up, and
+    jumped again after reset_world."""
+    mimic = f'<mimic joint="left_finger_joint" multiplier="{multiplier:g}" offset="0"/>'
+    sim, spawned = gripper(tmp_path, mimic=mimic)
+    try:
+        for _ in range(2):
+            spawned.robot.set_joint_velocity("left_finger_joint", 0.05, 20.0)
+            sim.step(300)
+            (follower, _, _), = spawned.robot.joint_state(["right_finger_joint"])
+            assert abs(follower) <= 0.04 + 1e-3
+            assert np.linalg.norm(spawned.robot.root_pose().position) < 0.05
+            sim.reset(simulation=False)
+            sim.step(300)
+            assert np.linalg.norm(spawned.robot.root_pose().position) < 0.05
+    finally:
+        sim.close()

@@ -22,10 +22,10 @@ from mbot_sim_bridge.robot_description import expand_xacro
 
 VLP16_MACRO = os.path.abspath(os.path.join(MOBILE_TEST_ROBOTS, "urdf", "VLP-16.urdf.xacro"))
 BAD_VALUES = (math.nan, math.inf, -math.inf, 1e308, -1e308)
-BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-300")
+BAD_TEXTS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-308")
 # For the tags of the later plugins: one of each kind (the parser refuses nan and inf alike; the sign of a huge
 # value is read the same way), so the suite stays within its time.
-TAG_TEXTS = ("nan", "-inf", "1e308", "1e-300")
+TAG_TEXTS = ("nan", "-inf", "1e308", "1e-308")
 BYSTANDER = """<robot name="crate"><link name="crate"><inertial><mass value="1"/>
   <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
   <collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision></link></robot>"""
@@ -90,7 +90,7 @@ def velodyne_urdf(tmp_path_factory):
 
 
 VELODYNE_FILES = ("libgazebo_ros_velodyne_laser.so",)
-VELODYNE_TAGS = ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples"]
+VELODYNE_TAGS = ["min_range", "max_range", "min_intensity", "gaussianNoise", "update_rate", "samples", "max_angle"]
 
 
 @pytest.mark.parametrize("text", BAD_TEXTS)

@@ -3,11 +3,15 @@ frozen with one message, and every other model keeps its pose (before, a NaN whe
 import logging
 import math
 import os
+from dataclasses import replace
 
 import pytest
 
+from mbot_sim_bridge.core.errors import BridgeError, ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
 from mbot_sim_bridge.core.description.robot_model import parse_robot
+from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.ros_control.controller_table import CORE_CONTROLLERS
 from mbot_sim_bridge.core.ros_control.diff_drive_controller import TwistController
 from mbot_sim_bridge.core.ros_control.four_wheel_steering_controller import FourWheelSteeringController
@@ -193,7 +197,71 @@ def test_a_healthy_run_freezes_nothing(mbot_ros_control_urdf, caplog):
     sim, _, _ = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
     try:
         sim.step(1000)
-        assert sim.engine.robots_not_finite() == []
+        assert sim.engine.models_not_finite() == []
         assert not messages(caplog, "frozen")
+    finally:
+        sim.close()
+
+
+CRATE = """<sdf version="1.6"><model name="crate"><pose>0 0 0.25 0 0 0</pose><link name="link">
+  <inertial><mass>{mass}</mass><inertia><ixx>{ixx}</ixx><iyy>{iyy}</iyy><izz>{izz}</izz></inertia></inertial>
+  <collision name="c"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision></link></model></sdf>"""
+
+
+def spawned_crate(tmp_path, name, position, mass=1.0, ixx=0.04, iyy=0.04, izz=0.04):
+    path = tmp_path / f"{name}.world"
+    path.write_text(spawn_world_xml(CRATE.format(mass=mass, ixx=ixx, iyy=iyy, izz=izz), name,
+                                    pose_from_xyz_rpy(position, (0, 0, 0))))
+    return parse_world(str(path))
+
+
+@pytest.mark.parametrize("inertial, message", [
+    ({"mass": 1e300}, r"<mass>: 1e\+300 is outside the valid range >= 1e-06 and <= 1e\+09"),
+    ({"mass": 1e-300}, r"<mass>: 1e-300 is outside the valid range >= 1e-06 and <= 1e\+09"),
+    ({"mass": -1}, r"<mass>: -1 is outside the valid range"),
+    ({"ixx": 0}, r"<inertia> has principal moments 0, 0.04, 0.04; they must be at least 1e-12"),
+    ({"ixx": 1e300}, r"<ixx>: 1e\+300 is outside the valid range >= -1e\+09 and <= 1e\+09"),
+    ({"ixx": 1, "iyy": 1, "izz": 3}, r"<inertia> has principal moments 1, 1, 3; .* at most the sum of the other two"),
+])
+def test_sdf_inertials_that_would_turn_the_model_nan_are_refused_naming_model_link_and_tag(tmp_path, inertial,
+                                                                                         message):
+    with pytest.raises(BridgeError, match=r"\.world:\d+: link 'link' of model 'crate': " + message):
+        spawned_crate(tmp_path, "crate", (0, 0, 0), **inertial)
+
+
+def test_a_movable_joint_without_an_axis_direction_is_refused():
+    urdf = ('<robot name="r"><link name="a"/><link name="b"/><joint name="spin" type="continuous">'
+            '<parent link="a"/><child link="b"/>\n<axis xyz="0 0 0"/></joint></robot>')
+    with pytest.raises(ModelError, match=r"^model 'r':2: joint 'spin': <axis xyz=\"0 0 0\"> has no direction; "
+                                         r"a continuous joint needs an axis of length at least 1e-06$"):
+        parse_robot(urdf, "model 'r'")
+
+
+def test_a_world_model_that_turns_nan_by_itself_is_put_back_once_then_deleted(tmp_path, mbot_ros_control_urdf,
+                                                                             caplog):
+    """Past the checks at the door (a mass of 1e300 set here on the parsed description), an SDF model the physics
+    turns NaN on every step is caught like a robot, put back once, deleted the second time; the others stay put
+    and reset_world leaves them as spawned."""
+    sim, _, _ = simulate(mbot_ros_control_urdf, load_yaml(MBOT_YAML), "mbot", namespace="/")
+    try:
+        resting = with_bystander(sim, mbot_ros_control_urdf)
+        sim.add_world(spawned_crate(tmp_path, "steady", (-2, 0, 0)))
+        sim.step(300)
+        steady = sim.engine.model_pose("steady").position
+        world = spawned_crate(tmp_path, "heavy", (0, 2, 0))
+        heavy = replace(world.models[0], links=tuple(replace(link, mass=1e300) for link in world.models[0].links))
+        with caplog.at_level(logging.ERROR):
+            sim.add_world(replace(world, models=(heavy,)))
+            sim.step(500)
+        assert "heavy" not in sim.model_names()
+        assert len(messages(caplog, "model 'heavy'", "NaN; it is put back")) == 1
+        assert len(messages(caplog, "model 'heavy'", "NaN again", "deleted")) == 1
+        assert math.dist(sim.engine.model_pose("bystander").position, resting) < 1e-4
+        assert math.dist(sim.engine.model_pose("steady").position, steady) < 1e-4
+        assert sim.engine.models_not_finite() == []
+        sim.reset(simulation=False)
+        assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 1e-6
+        assert math.dist(sim.engine.model_pose("bystander").position, (2, 0, 0)) < 1e-6
+        assert math.dist(sim.engine.model_pose("steady").position, (-2, 0, 0.25)) < 1e-6
     finally:
         sim.close()

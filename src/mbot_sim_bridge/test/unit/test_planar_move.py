@@ -93,3 +93,13 @@ def test_the_command_times_out_and_reset_stops_the_base(base):
     sim.reset(simulation=False)
     sim.step(50)
     assert math.hypot(*spawned.robot.root_velocity()[0][:2]) < 0.01
+
+
+@pytest.mark.parametrize("command", [(1e10, 0.0, 0.0), (0.0, -1e5, 0.0), (0.0, 0.0, 1e300)])
+def test_a_command_beyond_set_model_states_cap_is_refused(base, command):
+    """1e10 m/s sent the base 50 m backwards in one step; beyond 1e4 (set_model_state's cap) it is refused."""
+    sim, spawned, plugin = base
+    start = spawned.robot.root_pose().position
+    assert not plugin.set_command(*command)
+    sim.step(100)
+    assert math.dist(spawned.robot.root_pose().position, start) < 1e-3

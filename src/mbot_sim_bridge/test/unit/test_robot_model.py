@@ -20,8 +20,9 @@ def link(name, geometry='<box size="0.1 0.1 0.1"/>', inertial=INERTIAL):
 
 
 def joint(name, kind, parent, child, xyz="0 0 0"):
+    limit = '<limit lower="-1" upper="1" effort="1" velocity="1"/>' if kind in ("revolute", "prismatic") else ""
     return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><origin '
-            f'xyz="{xyz}"/><axis xyz="0 1 0"/></joint>')
+            f'xyz="{xyz}"/><axis xyz="0 1 0"/>{limit}</joint>')
 
 
 def test_course_mbot_lumps_fixed_links_like_gazebo(mbot_urdf):
@@ -149,3 +150,21 @@ def test_a_mesh_that_is_not_a_regular_file_is_refused_unopened(tmp_path):
 def test_named_materials_stay_for_the_visuals_that_refer_to_them():
     urdf = robot('<material name="red"><color rgba="1 0 0 1"/></material>', link("a"))
     assert '<material name="red"><color rgba="1 0 0 1" /></material>' in parse_robot(urdf).pybullet_urdf
+
+
+@pytest.mark.parametrize("joints, message", [
+    ('<joint name="shoulder" type="revolute"><parent link="chassis"/><child link="arm"/></joint>',
+     r"^robot_description:\d+: joint 'shoulder' is of type revolute but it does not specify limits"),
+    (joint("shoulder", "prismatic", "chassis", "arm").replace('lower="-1" upper="1"', 'lower="1" upper="-1"'),
+     r"joint 'shoulder': <limit lower=\"1\"> is above upper=\"-1\"$"),
+    (joint("a", "continuous", "chassis", "arm").replace("</joint>", '<mimic joint="a"/></joint>'),
+     r"joint 'a': <mimic> joints follow each other in a circle: a -> a;"),
+    (joint("a", "continuous", "chassis", "arm").replace("</joint>", '<mimic joint="b"/></joint>')
+     + joint("b", "continuous", "arm", "hand").replace("</joint>", '<mimic joint="a"/></joint>'),
+     r"joint 'a': <mimic> joints follow each other in a circle: a -> b -> a;"),
+])
+def test_joints_urdfdom_or_the_physics_cannot_take_are_refused_with_one_line(joints, message):
+    links = "".join(f'<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" '
+                    f'ixy="0" ixz="0" iyz="0"/></inertial></link>' for name in ("chassis", "arm", "hand"))
+    with pytest.raises(ModelError, match=message):
+        parse_robot(f'<robot name="r">{links}{joints}</robot>')

@@ -4,6 +4,7 @@ two-joint arm driven through the controllers in the simulation, with no ROS mast
 import logging
 import math
 import os
+import threading
 
 import pytest
 
@@ -36,6 +37,22 @@ def mbot(mbot_ros_control_urdf):
     assert switch(sim, manager, ["joint_state_controller", "mobile_base_controller"])
     yield sim, spawned, plugin, manager.find("mobile_base_controller").controller
     sim.close()
+
+
+def test_a_switch_pending_when_its_model_is_deleted_is_answered_not_carried_out(mbot, caplog):
+    """A STRICT switch with timeout 0 waits for the control loop for ever, as upstream's; paused, the loop does
+    not come, and deleting the model must still answer the call (before, it never returned)."""
+    sim, _, plugin, _ = mbot
+    result = []
+    thread = threading.Thread(target=lambda: result.append(plugin.manager.switch([], ["mobile_base_controller"], 2)),
+                              daemon=True)
+    thread.start()
+    thread.join(0.3)
+    assert thread.is_alive(), "the switch ran without a control update"
+    sim.delete("mbot")
+    thread.join(5.0)
+    assert not thread.is_alive() and result == [False]
+    assert "the model was deleted before the pending controller switch ran; nothing was switched" in caplog.text
 
 
 # -- transmissions and limits ----------------------------------------------------------------------------------

@@ -3,13 +3,16 @@ plugins' core classes and no ROS master; per-sensor random streams; plugin failu
 import logging
 import math
 import os
+import re
+import sys
 
 import numpy as np
 import pytest
 from sensor_fixtures import plugin_of
 
+from mbot_sim_bridge.core.clock import UpdateTimer
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
-from mbot_sim_bridge.core.errors import ConfigError
+from mbot_sim_bridge.core.errors import ConfigError, ModelError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.joints.joint_states import JointStatePublisher
 from mbot_sim_bridge.core.sensors.lidar import RaySensor
@@ -115,6 +118,86 @@ def test_a_failing_plugin_is_disabled_and_the_rest_runs(mbot_urdf, caplog):
         assert "model 'mbot': plugin GazeboRosDiffDrive(ns = /) failed and is disabled" in caplog.text
         sim.step(100)
         assert sim.sim_time == pytest.approx(0.2)
+    finally:
+        sim.close()
+
+
+def test_a_plugin_whose_timer_overflows_is_disabled_and_the_rest_runs(mbot_urdf, caplog):
+    """A timer that raises (here a period of 1e308 s counted in steps, as a rate of 1e-308 Hz gave) is its
+    plugin's failure, contained like one, in stepping and in reset."""
+    sim = simulation()
+    try:
+        spawned = sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), "mbot")
+        drive = plugin_of(spawned, DiffDrive)
+
+        def overflow(*_):
+            return math.floor(math.inf)
+        drive.timer.steps_until_due = overflow
+        with caplog.at_level(logging.ERROR):
+            sim.step(100)
+        assert drive not in spawned.plugins
+        assert caplog.text.count("GazeboRosDiffDrive(ns = /) failed and is disabled: OverflowError") == 1
+        joint_states = plugin_of(spawned, JointStatePublisher)
+        joint_states.timer.due = overflow
+        sim.reset(simulation=False)
+        sim.step(100)
+        assert spawned.plugins == [] and sim.sim_time == pytest.approx(0.2)
+    finally:
+        sim.close()
+
+
+def test_a_rate_or_period_too_small_to_count_is_refused_and_never_overflows(mbot_urdf):
+    """1e-308 Hz is a period of 1e308 s: refused at the door, and a timer given it anyway is never due."""
+    sim = simulation()
+    try:
+        urdf = mbot_urdf.replace("<updateRate>100.0</updateRate>", "<updateRate>1e-308</updateRate>", 1)
+        assert urdf != mbot_urdf
+        with pytest.raises(ConfigError, match=r"model 'mbot':\d+: GazeboRosDiffDrive\(ns = /\): <updateRate> has bad "
+                                              r"value '1e-308': 1e-308 is outside the valid range <= 0 or >= 1e-06$"):
+            sim.spawn_robot(parse_robot(urdf, "model 'mbot'"), "mbot")
+        assert sim.model_names() == ["ground_plane"]
+    finally:
+        sim.close()
+    for rate in (1e-308, 5e-324):
+        timer = UpdateTimer(rate)
+        assert timer.steps_until_due(1.0, 0.001) == sys.maxsize and not timer.due(1e9)
+
+
+def revolute_chain(joints: int) -> str:
+    links = ['<link name="l0"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+             'iyz="0"/></inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>']
+    for index in range(1, joints + 1):
+        links.append(f'<link name="l{index}"><inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001" '
+                     f'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+                     f'<joint name="j{index}" type="revolute"><parent link="l{index - 1}"/><child link="l{index}"/>'
+                     f'<origin xyz="0 0 0.01"/><axis xyz="0 0 1"/>'
+                     f'<limit lower="-1" upper="1" effort="10" velocity="1"/></joint>')
+    return f'<robot name="chain">{chr(10).join(links)}</robot>'
+
+
+@pytest.mark.parametrize("joints", [128, 1000])
+def test_more_movable_joints_than_a_pybullet_body_holds_are_refused_and_leave_nothing(joints):
+    sim = simulation()
+    try:
+        with pytest.raises(ModelError, match=rf"^SpawnModel: model 'chain': {joints} movable joints; a PyBullet body "
+                                             r"holds at most 127 \(128 links with the base\); nothing was spawned$"):
+            sim.spawn_robot(parse_robot(revolute_chain(joints), "model 'chain'"), "chain")
+        assert sim.model_names() == ["ground_plane"] and sim.engine.client.getNumBodies() == 1
+        sim.spawn_robot(parse_robot(revolute_chain(127), "model 'chain'"), "chain")
+        sim.step(10)
+        assert sim.engine.models_not_finite() == []
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("name", ["", "a::b", "/", "a b"])
+def test_a_name_gazebo_could_not_address_is_refused(mbot_urdf, name):
+    sim = simulation()
+    try:
+        with pytest.raises(ModelError, match=rf"^SpawnModel: model name {re.escape(repr(name))}: a model name must be "
+                                             r"non-empty, without whitespace, '::' .* or '/'; nothing was spawned$"):
+            sim.spawn_robot(parse_robot(mbot_urdf, "model 'mbot'"), name)
+        assert sim.model_names() == ["ground_plane"]
     finally:
         sim.close()
 

@@ -1,6 +1,7 @@
 """libgazebo_ros_skid_steer_drive.so (core/drives/skid_steer_drive.py) on mobile_test_robots' skid-steer base: straight
 lines within 5 %, turns the commanded way, ground-truth odometry, bad joints refused, NaN ignored, reset."""
 import math
+import re
 
 import pytest
 from plugin_robots import SKID_XACRO
@@ -62,3 +63,28 @@ def test_a_wheel_joint_the_robot_lacks_is_refused(tmp_path):
         sim.spawn_robot(parse_robot(urdf().replace('name="rear_left_wheel_joint"', 'name="rear_left_hinge"'),
                                     "model 'skid'"), "skid")
     sim.close()
+
+
+def test_wheels_mapped_to_one_joint_are_refused(tmp_path):
+    sim = world_simulation(tmp_path)
+    try:
+        text = urdf()
+        for tag in ("rightFrontJoint", "leftRearJoint", "rightRearJoint"):
+            text = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>front_left_wheel_joint</{tag}>", text)
+        with pytest.raises(ConfigError, match="<leftFrontJoint> and <rightFrontJoint> both name joint "
+                                              "'front_left_wheel_joint'"):
+            sim.spawn_robot(parse_robot(text, "model 'skid'"), "skid")
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize("tag", ["wheelDiameter", "wheelSeparation"])
+def test_a_wheel_size_below_a_millimetre_is_refused(tmp_path, tag):
+    """Found by the fuzz sweep: a diameter of 5e-324 halves to 0, and the drive divided by it while stepping."""
+    sim = world_simulation(tmp_path)
+    try:
+        text = re.sub(f"<{tag}>[^<]*</{tag}>", f"<{tag}>5e-324</{tag}>", urdf())
+        with pytest.raises(ConfigError, match=f"<{tag}> has bad value '5e-324': .* outside the valid range >= 0.001"):
+            sim.spawn_robot(parse_robot(text, "model 'skid'"), "skid")
+    finally:
+        sim.close()

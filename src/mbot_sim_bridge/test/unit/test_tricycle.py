@@ -95,6 +95,23 @@ def test_a_steering_joint_the_robot_lacks_is_refused(tmp_path):
     sim.close()
 
 
+@pytest.mark.parametrize("joint, message", [
+    ("laser_joint", "<steeringJoint> names joint 'laser_joint', which is fixed; movable joints:"),
+    ("front_wheel_joint", "<steeringJoint> and <actuatedWheelJoint> both name joint 'front_wheel_joint'; each needs "
+                          "a joint of its own"),
+])
+def test_a_steering_joint_that_cannot_steer_is_refused(tmp_path, joint, message):
+    sim = world_simulation(tmp_path)
+    try:
+        text = urdf().replace("<steeringJoint>front_steering_joint</steeringJoint>",
+                              f"<steeringJoint>{joint}</steeringJoint>")
+        with pytest.raises(ConfigError, match=message):
+            sim.spawn_robot(parse_robot(text, "model 'tricycle'"), "tricycle", ON_ITS_WHEELS)
+        assert "tricycle" not in sim.model_names()
+    finally:
+        sim.close()
+
+
 def test_nan_is_ignored_and_reset_stops_it(tmp_path):
     sim, spawned, plugin = spawn(tmp_path, urdf())
     assert plugin.set_command(0.4, 0.1)

@@ -1,12 +1,14 @@
 """Velodyne's lidar plugins (core/sensors/velodyne_laser.py) on the VLP-16-style macro of mobile_test_robots: 16 rings
 in the driver's order, points on a wall where it stands, range limits, organised clouds, the PointCloud2 layout."""
 import os
+import re
 
 import numpy as np
 import pytest
 from plugin_robots import MOBILE_TEST_ROBOTS, VELODYNE_STAND
 from sensor_fixtures import box, plugin_of, world_simulation
 
+from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.sensors.velodyne_laser import VelodyneLaser
@@ -26,6 +28,28 @@ def velodyne(tmp_path, noise=0.0, organize=False):
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand", Pose((0.0, 0.0, 0.0), (0, 0, 0, 1)))
     sim.step(10)
     return sim, plugin_of(spawned, VelodyneLaser)
+
+
+@pytest.mark.parametrize("tags, message", [
+    ({"min_range": "10", "max_range": "1"}, r"readings are kept between <min_range> 10 .* and <max_range> 1 .*: "
+                                            r"none would be$"),
+    ({"max_range": "0"}, r"<max_range> has bad value '0': 0 is outside the valid range > 0$"),
+])
+def test_a_range_window_that_keeps_nothing_is_refused(tmp_path, tags, message):
+    path = tmp_path / "stand.urdf.xacro"
+    macro = os.path.abspath(os.path.join(MOBILE_TEST_ROBOTS, "urdf", "VLP-16.urdf.xacro"))
+    path.write_text(VELODYNE_STAND.format(macro=macro, noise=0.0, organize="false"))
+    urdf = expand_xacro(str(path))
+    for tag, text in tags.items():
+        urdf, replaced = re.subn(f"<{tag}>[^<]*</{tag}>", f"<{tag}>{text}</{tag}>", urdf)
+        assert replaced == 1
+    sim = world_simulation(tmp_path)
+    try:
+        with pytest.raises(ConfigError, match=message):
+            sim.spawn_robot(parse_robot(urdf, "model 'stand'"), "stand")
+        assert "stand" not in sim.model_names()
+    finally:
+        sim.close()
 
 
 def test_sixteen_rings_lowest_first_and_points_on_the_wall(tmp_path):

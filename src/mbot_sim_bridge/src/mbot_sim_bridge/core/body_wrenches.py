@@ -14,6 +14,7 @@ force. The result is applied in the world frame, so a wrench given in the link's
 axes (upstream's "FIXME map is really wrong").
 """
 import math
+import sys
 import threading
 from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
@@ -26,6 +27,9 @@ ZERO = (0.0, 0.0, 0.0)
 WORLD_FRAMES = ("", "world", "map", "/map")
 # apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
 MAX_WRENCH = 1e6
+# Its largest start time and duration (s): what a ROS time or duration can carry (a uint32 or int32 of seconds),
+# so every request through ROS passes, and a start of 1e308 s cannot overflow the loop's count of steps to it.
+MAX_WRENCH_TIME = 2.0 ** 32
 
 
 class WrenchJob(NamedTuple):
@@ -57,12 +61,15 @@ def target_wrench(force: Sequence[float], torque: Sequence[float], reference_poi
 
 
 def requested_job(body: str, reference_frame: str, reference_point: Sequence[float], force: Sequence[float],
-                  torque: Sequence[float], start: float, duration: float, link_names: Callable[[str], List[str]],
-                  link_pose: Callable[[str, str], Pose], entity_pose: Callable[[str], Optional[Pose]]) -> WrenchJob:
+                  torque: Sequence[float], start: float, duration: float, now: float,
+                  link_names: Callable[[str], List[str]], link_pose: Callable[[str, str], Pose],
+                  entity_pose: Callable[[str], Optional[Pose]]) -> WrenchJob:
     """An apply_body_wrench request as a job on link ``body`` ("model::link"), checked as gazebo_ros checks it: an
     unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite or
-    beyond MAX_WRENCH (the physics would turn the model's state NaN). The simulation's ``link_names(model)``,
-    ``link_pose(model, link)`` and ``entity_pose(name)`` (None: no such entity) say what exists where."""
+    beyond MAX_WRENCH (the physics would turn the model's state NaN), or a start time or duration that is not
+    finite or beyond MAX_WRENCH_TIME. A start before ``now`` (the sim time) is now, as upstream's. The
+    simulation's ``link_names(model)``, ``link_pose(model, link)`` and ``entity_pose(name)`` (None: no such
+    entity) say what exists where."""
     model, _, link = body.partition("::")
     if link not in link_names(model):
         known = ", ".join(f"{model}::{name}" for name in link_names(model)) or "no such model"
@@ -71,13 +78,17 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
         raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
                          f"at most {MAX_WRENCH:g} in size; got {values}")
+    if not all(abs(value) <= MAX_WRENCH_TIME for value in (start, duration)):  # False for NaN too
+        raise ModelError(f"ApplyBodyWrench: body '{body}': start_time and duration must be finite and at most "
+                         f"{MAX_WRENCH_TIME:g} s in size (what a ROS time holds); got start_time {start}, "
+                         f"duration {duration}")
     frame_pose = None
     if reference_frame not in WORLD_FRAMES:
         frame_pose = entity_pose(reference_frame)
         if frame_pose is None:
             raise ModelError(f"ApplyBodyWrench: reference_frame '{reference_frame}' is not a valid entity name")
     force, torque = target_wrench(force, torque, reference_point, link_pose(model, link), frame_pose)
-    return WrenchJob(model, link, force, torque, start, duration)
+    return WrenchJob(model, link, force, torque, max(start, now), duration)
 
 
 class BodyWrenches:
@@ -106,7 +117,10 @@ class BodyWrenches:
             starts = [job.start for job in self._jobs]
         if not starts:
             return None
-        return max(1, int(np.ceil((min(starts) - now) / step_size - 1e-9)))
+        steps = (min(starts) - now) / step_size - 1e-9
+        if not steps < sys.maxsize:  # a start too far off to count in steps (1e308 s overflowed): not due
+            return sys.maxsize
+        return max(1, int(np.ceil(steps)))
 
     def due(self, now: float) -> Dict[Tuple[str, str], Tuple[Vector, Vector]]:
         """(model, link) -> (force, torque) to apply in the step starting at ``now``; ended jobs are dropped."""

@@ -43,6 +43,8 @@ class UpdateTimer:
             return 1
         remaining = self.last + self.period - now
         steps = remaining / step_size
+        if not -sys.maxsize < steps < sys.maxsize:  # a period too long to count in steps: not due within a run
+            return 1 if steps < 0 else sys.maxsize
         whole = math.floor(steps + _EPSILON) + 1 if self.strict else math.ceil(steps - _EPSILON)
         return max(1, whole)
 

@@ -47,6 +47,9 @@ PENETRATION_TOLERANCE = 1.0e-5  # m
 # A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
 # stay finite below it.
 MAX_WHEEL_MU = 1.0e3
+# PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
+# every query fails ("GetBasePositionAndOrientation failed").
+MAX_BODY_LINKS = 128
 
 
 class CachingBulletClient(BulletClient):
@@ -119,6 +122,14 @@ def check_state(what: str, pose: Pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0
                          f"nothing was changed")
 
 
+def check_model_name(what: str, name: str):
+    """ModelError for a name Gazebo could not address: empty, with whitespace, Gazebo's scope separator "::"
+    ("model::link" names a link) or "/"."""
+    if not name or "::" in name or "/" in name or any(character.isspace() for character in name):
+        raise ModelError(f"{what}: model name {name!r}: a model name must be non-empty, without whitespace, '::' "
+                         f"(which separates a model's links) or '/'; nothing was spawned")
+
+
 class RecordedLinkStates(NamedTuple):
     """A link frame at consecutive steps, one row each, in the world."""
     orientations: np.ndarray  # (N, 4) xyzw
@@ -186,8 +197,9 @@ class SpawnedRobot:
 
     def joint_rows(self, indices: Sequence[int]):
         """PyBullet's getJointStates rows (position, velocity, reaction wrench, applied effort) of joints by
-        ``joint_index``: joint_state without its name lookups and copies, for readers after every step."""
-        return self.client.getJointStates(self.body, indices)
+        ``joint_index``: joint_state without its name lookups and copies, for readers after every step. PyBullet
+        answers None for no joints."""
+        return self.client.getJointStates(self.body, indices) or ()
 
     def link_world_velocity(self, link_name: str):
         """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
@@ -280,6 +292,7 @@ class Engine:
         self.steps = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
+        self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
         # PyBullet body -> link index -> Gazebo's "model::link::collision" of the collision it holds.
         self.collision_names: Dict[int, Dict[int, str]] = {}
         self._initial: Dict[int, _InitialState] = {}
@@ -316,6 +329,7 @@ class Engine:
         self.steps = 0
         self.robots.clear()
         self.world_bodies.clear()
+        self.dynamic_world_bodies.clear()
         self.collision_names.clear()
         self._initial.clear()
         self._root_from_com.clear()
@@ -359,6 +373,8 @@ class Engine:
         """Register the bodies a world loader built, so reset and model queries know them."""
         for name, body in world.bodies.items():
             self.world_bodies[name] = body
+            if self.client.getDynamicsInfo(body, -1)[0] > 0.0:
+                self.dynamic_world_bodies[name] = body
             shapes = [shape for shape in world.shapes if shape.model == name]
             # One static collision is the body's base; otherwise each collision is a child link, in order.
             links = [-1] if self.client.getNumJoints(body) == 0 else range(len(shapes))
@@ -379,7 +395,12 @@ class Engine:
         """
         if name in self.robots or name in self.world_bodies:
             raise ModelError(f"model '{name}' already exists")
+        check_model_name("SpawnModel", name)
         check_state(f"SpawnModel: model '{name}'", pose)
+        body_links = len({holder for holder, _ in model.lumped_into.values()})
+        if body_links > MAX_BODY_LINKS:
+            raise ModelError(f"SpawnModel: model '{name}': {body_links - 1} movable joints; a PyBullet body holds at "
+                             f"most {MAX_BODY_LINKS - 1} ({MAX_BODY_LINKS} links with the base); nothing was spawned")
         robot = SpawnedRobot(self.client, name, model, self._load_urdf(model, pose), namespace, pose)
         self._place(robot, driven_joints)
         return robot
@@ -411,6 +432,7 @@ class Engine:
             body = self.robots.pop(name).body
         elif name in self.world_bodies:
             body = self.world_bodies.pop(name)
+            self.dynamic_world_bodies.pop(name, None)
         else:
             raise ModelError(f"model '{name}' does not exist")
         self._initial.pop(body, None)
@@ -534,13 +556,14 @@ class Engine:
     def _name_of(self, body: int) -> str:
         return next(name for name in self.model_names() if self.body_of(name) == body)
 
-    def robots_not_finite(self) -> List[str]:
-        """The robots whose base pose the last steps made NaN or infinite. Run after every step, so kept to one
-        state query and one sum per robot (a NaN or inf anywhere makes the sum so)."""
+    def models_not_finite(self) -> List[str]:
+        """The robots and moving world models whose base pose the last steps made NaN or infinite. Run after every
+        batch of steps, so kept to one state query and one sum per body (a NaN or inf anywhere makes the sum so)."""
         state, finite = self.client.getBasePositionAndOrientation, math.isfinite
+        bodies = chain(((name, robot.body) for name, robot in self.robots.items()), self.dynamic_world_bodies.items())
         broken = []
-        for name, robot in self.robots.items():
-            position, orientation = state(robot.body)
+        for name, body in bodies:
+            position, orientation = state(body)
             if not finite(sum(position) + sum(orientation)):
                 broken.append(name)
         return broken

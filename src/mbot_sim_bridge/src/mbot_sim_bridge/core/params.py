@@ -19,6 +19,10 @@ _logger = get_logger(__name__)
 # The largest error model value (noise, drift, offset, scale) a sensor tag may give: far beyond any sensor, and
 # small enough that the products a sensor model forms stay finite.
 ERROR_MODEL_LIMIT = 1e6
+# The slowest update rate (Hz) and longest update period (s) a tag may give: one update in 11.6 days of sim
+# time. A rate of 1e-308 Hz is a period of 1e308 s, which overflows when counted in physics steps.
+MIN_RATE = 1e-6
+MAX_PERIOD = 1.0 / MIN_RATE
 
 _PARSERS: Dict[type, Callable[[str], Any]] = {bool: parse_bool, float: parse_float, int: parse_int, str: str.strip}
 
@@ -36,13 +40,14 @@ class Param:
     minimum: Optional[float] = None
     maximum: Optional[float] = None
     exclusive_minimum: bool = False  # True: value > minimum
+    least_positive: Optional[float] = None  # values in (0, least_positive) are refused too
 
     @property
     def valid_range(self) -> str:
         if self.choices is not None:
             return "one of " + ", ".join(self.choices)
         if self.kind in (int, float):
-            return describe_range(self.minimum, self.maximum, self.exclusive_minimum)
+            return describe_range(self.minimum, self.maximum, self.exclusive_minimum, self.least_positive)
         return ""
 
 
@@ -53,6 +58,19 @@ def positive(tag: str, kind: type, default: Any, doc: str = "", **options) -> Pa
 
 def non_negative(tag: str, kind: type, default: Any, doc: str = "", **options) -> Param:
     return Param(tag, kind, default, doc, minimum=0, **options)
+
+
+def rate(tag: str, default: float, doc: str = "", signed: bool = False, **options) -> Param:
+    """An update rate in Hz: 0 (or any value <= 0 when ``signed``) has the tag's own meaning, usually every
+    physics step; a positive rate is at least MIN_RATE."""
+    if not signed:
+        options.setdefault("minimum", 0)
+    return Param(tag, float, default, doc, least_positive=MIN_RATE, **options)
+
+
+def period(tag: str, default: float, doc: str = "", **options) -> Param:
+    """An update period in s, at most MAX_PERIOD."""
+    return Param(tag, float, default, doc, minimum=0, maximum=MAX_PERIOD, **options)
 
 
 class PluginParams:
@@ -96,7 +114,7 @@ class PluginParams:
         try:
             value = _PARSERS[param.kind](text)
             if param.kind in (int, float):
-                check_range(value, param.minimum, param.maximum, param.exclusive_minimum)
+                check_range(value, param.minimum, param.maximum, param.exclusive_minimum, param.least_positive)
         except ValueError as error:
             raise ConfigError(f"{self._prefix}: <{param.tag}> has bad value '{text}': {error}") from None
         if param.choices is not None and value not in param.choices:

@@ -135,13 +135,20 @@ class Plugin:
         return reader.read(self.PARAMS if params is None else params)
 
     def named_joints(self, params: Dict[str, Any], tags: Sequence[str]) -> Tuple[str, ...]:
-        """The joints the tags name; one the robot lacks refuses the spawn, listing the movable joints."""
-        robot = self.context.robot
+        """The joints the tags name; one the robot lacks (or has as a fixed joint), or one named by two of the
+        tags, refuses the spawn, listing the movable joints."""
+        robot, where = self.context.robot, f"{self.context.where(self.element)}: {self.label}"
+        named: Dict[str, str] = {}
         for tag in tags:
-            if params[tag] not in robot.joint_index:
+            joint = params[tag]
+            if joint not in robot.joint_index:
                 movable = ", ".join(robot.movable_joints) or "none"
-                raise ConfigError(f"{self.context.where(self.element)}: {self.label}: <{tag}> names joint "
-                                  f"'{params[tag]}', which the robot does not have; movable joints: {movable}")
+                what = "which is fixed" if joint in robot.model.joints else "which the robot does not have"
+                raise ConfigError(f"{where}: <{tag}> names joint '{joint}', {what}; movable joints: {movable}")
+            if joint in named:
+                raise ConfigError(f"{where}: <{named[joint]}> and <{tag}> both name joint '{joint}'; each needs a "
+                                  f"joint of its own")
+            named[joint] = tag
         return tuple(params[tag] for tag in tags)
 
     def on_step(self, step_size: float):

@@ -7,6 +7,7 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 ROS layer's registry derived from it, so the core never imports the ROS plugin layer.
 """
 import hashlib
+import sys
 from dataclasses import replace
 from typing import Callable, Dict, List, Mapping, NamedTuple, Optional, Sequence, Set, Tuple
 from xml.etree import ElementTree
@@ -75,7 +76,7 @@ class Simulation:
         self._plugins: List[Plugin] = []
         self._every_step_calls: List[Callable[[], None]] = []  # on_step of the plugins that need every step
         self._recording: List[Plugin] = []
-        self._frozen: Set[str] = set()  # robots the physics turned NaN, held until a reset
+        self._frozen: Set[str] = set()  # models the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
         self.add_world(world)
@@ -172,9 +173,8 @@ class Simulation:
                           duration: float):
         """Schedule a wrench on link ``body`` ("model::link"), as gazebo_ros's apply_body_wrench; the request is
         checked and made a job by ``body_wrenches.requested_job`` (ModelError with upstream's message)."""
-        self.wrenches.add(requested_job(body, reference_frame, reference_point, force, torque,
-                                        max(start_time, self.sim_time), duration, self.link_names, self._link_pose,
-                                        self._entity_pose))
+        self.wrenches.add(requested_job(body, reference_frame, reference_point, force, torque, start_time, duration,
+                                        self.sim_time, self.link_names, self._link_pose, self._entity_pose))
 
     def clear_body_wrenches(self, body: str):
         model, _, link = body.partition("::")
@@ -334,7 +334,9 @@ class Simulation:
         wrench_steps = self.wrenches.steps_until_next(now, step)
         if wrench_steps is not None:
             batch = min(batch, wrench_steps)
-        return min([batch] + [plugin.timer.steps_until_due(now, step) for plugin in self._plugins])
+        # A timer is part of its plugin: one that raises (an overflowing period) disables the plugin, not the loop.
+        return min([batch] + [self._guarded(plugin, plugin.timer.steps_until_due, now, step) or sys.maxsize
+                              for plugin in self._plugins])
 
     def advance(self, max_steps: int, before_updates: Optional[BeforeUpdates] = None) -> int:
         """Step up to the next plugin event or ``max_steps``, then run the due updates; returns the steps taken."""
@@ -345,11 +347,11 @@ class Simulation:
         per_step = [recorder for recorder in recorders if recorder is not None]
         per_step += self._every_step_calls
         self.engine.step(count, per_step)
-        broken = self.engine.robots_not_finite()
+        broken = self.engine.models_not_finite()
         if broken:
             self._freeze(broken)
         now = self.sim_time
-        due = [plugin for plugin in self._plugins if plugin.timer.due(now)]
+        due = [plugin for plugin in self._plugins if self._guarded(plugin, plugin.timer.due, now)]
         if before_updates is not None:
             before_updates(now, bool(due))
         for plugin in due:
@@ -359,10 +361,16 @@ class Simulation:
         return count
 
     def _freeze(self, names: Sequence[str]):
-        """Robots whose state the physics made NaN go back to their spawn state with their plugins stopped until
-        a reset. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
+        """Models whose state the physics made NaN go back to their spawn state (a robot with its plugins stopped)
+        until a reset; one that turns NaN again by itself is deleted, so the recovery is not repeated every
+        step. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
         through the ground, and even a static ground plane reads NaN), so the world is rebuilt with every other
         moving model's state carried over."""
+        for name in [name for name in names if name in self._frozen]:
+            self.delete(name)
+            _logger.error(f"model '{name}': the physics made its state NaN again after it was put back at its spawn "
+                          "pose, with nothing driving it; it is deleted")
+        names = [name for name in names if name in self.model_names()]
         moving = [name for name in self.engine.model_names() if name not in names and not (
             name in self.world_models and self.world_models[name].static)]
         kept = {name: state for name, state in self.engine.body_states(moving).items() if state.finite}
@@ -376,7 +384,7 @@ class Simulation:
         self.version += 1
         for name in names:
             _logger.error(f"model '{name}': the physics step made its state NaN; it is put back at its spawn pose "
-                          "and frozen (its plugins stopped) until reset_world or reset_simulation")
+                          "and frozen (a robot's plugins stopped) until reset_world or reset_simulation")
 
     def step(self, count: int, before_updates: Optional[BeforeUpdates] = None):
         """Exactly ``count`` physics steps, with every plugin event on the way."""
@@ -397,11 +405,11 @@ class Simulation:
                     self._disable(plugin, error)
         return on_step
 
-    def _guarded(self, plugin: Plugin, method, argument):
-        """``method(argument)``; a plugin that raises is disabled (None is returned), and the simulation and
+    def _guarded(self, plugin: Plugin, method, *arguments):
+        """``method(*arguments)``; a plugin that raises is disabled (None is returned), and the simulation and
         other models go on."""
         try:
-            return method(argument)
+            return method(*arguments)
         except Exception as error:  # the plugin boundary: a failure inside one plugin must not stop the others
             self._disable(plugin, error)
 
@@ -428,6 +436,7 @@ class Simulation:
         else:
             self.engine.reset_world()
         self._frozen.clear()
+        self.wrenches = BodyWrenches()  # resets repair what service calls left: wrenches "until cleared" too
         self._schedule()
         self.version += 1
         for plugin in list(self._plugins):

@@ -111,15 +111,22 @@ def parse_int(text: str) -> int:
 
 
 def check_range(value: float, minimum: Optional[float] = None, maximum: Optional[float] = None,
-                exclusive_minimum: bool = False) -> None:
-    """ValueError naming the valid range when ``value`` is outside it."""
+                exclusive_minimum: bool = False, least_positive: Optional[float] = None) -> None:
+    """ValueError naming the valid range when ``value`` is outside it; ``least_positive`` also refuses the
+    values between 0 and it (a rate so small that its period overflows)."""
     low_ok = minimum is None or (value > minimum if exclusive_minimum else value >= minimum)
     high_ok = maximum is None or value <= maximum
-    if not (low_ok and high_ok):
-        raise ValueError(f"{value:g} is outside the valid range {describe_range(minimum, maximum, exclusive_minimum)}")
+    tiny = least_positive is not None and 0 < value < least_positive
+    if not (low_ok and high_ok) or tiny:
+        valid = describe_range(minimum, maximum, exclusive_minimum, least_positive)
+        raise ValueError(f"{value:g} is outside the valid range {valid}")
 
 
-def describe_range(minimum: Optional[float], maximum: Optional[float], exclusive_minimum: bool = False) -> str:
+def describe_range(minimum: Optional[float], maximum: Optional[float], exclusive_minimum: bool = False,
+                   least_positive: Optional[float] = None) -> str:
+    if least_positive is not None:
+        at_most_zero = "0" if minimum == 0 else "<= 0"
+        return f"{at_most_zero} or >= {least_positive:g}" + ("" if maximum is None else f" and <= {maximum:g}")
     low = "" if minimum is None else f"{'>' if exclusive_minimum else '>='} {minimum:g}"
     high = "" if maximum is None else f"<= {maximum:g}"
     return " and ".join(part for part in (low, high) if part) or "any finite number"

@@ -1,6 +1,7 @@
 """What the drives' ROS sides share: cmd_vel into the core's TwistCommand, and the odometry topic and odom TF of
 the drive plugins that report the ground truth (planar move, skid steer, tricycle): messages made once and
 refilled, each published only while someone listens."""
+import math
 from operator import attrgetter
 from typing import Optional
 
@@ -14,12 +15,14 @@ from .messages import set_pose, set_quaternion, set_xyz
 
 
 def on_twist(plugin, message: Twist):
-    """cmd_vel to a TwistCommand drive (the axes it reads); a non-finite one is refused with a throttled warning."""
+    """cmd_vel to a TwistCommand drive (the axes it reads); one that is not finite or beyond the drive's
+    COMMAND_LIMIT is refused with a throttled warning."""
     values = [attrgetter(axis)(message) for axis in plugin.COMMAND_AXES]
     if not plugin.set_command(*values):
         given = ", ".join(f"{axis} {value}" for axis, value in zip(plugin.COMMAND_AXES, values))
-        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a non-finite value "
-                                    f"({given}); keeping the last valid command")
+        beyond = f" or beyond {plugin.COMMAND_LIMIT:g}" if math.isfinite(plugin.COMMAND_LIMIT) else ""
+        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a value that is not "
+                                    f"finite{beyond} ({given}); keeping the last valid command")
 
 
 class OdometryOutput:

@@ -35,7 +35,7 @@ from .image_formats import (FORMAT_ENCODINGS, add_image_noise, convert_image, de
                             image_encoding, point_cloud)
 from ..geometry import Pose, compose
 from ..log import get_logger, info_once, warn_once
-from ..params import Param, PluginParams, non_negative, positive
+from ..params import Param, PluginParams, non_negative, positive, rate
 from ..plugin import Plugin
 from ..sensors.sensor_elements import gaussian_noise, sensor_label, sensor_pose
 from .render_scene import CameraConfig, CameraRenderer
@@ -45,10 +45,13 @@ _log = get_logger(__name__)
 
 # The rate a sensor with <update_rate> 0 and plugin updateRate 0 renders at (Gazebo: as fast as it can).
 DEFAULT_FRAME_RATE = 30.0
+# Pixels per frame at most: the loop waits for each frame, and a depth frame of 4096 x 2160 took 7.5 s (0.5 GB),
+# one of 8192 x 8192 16 s and 3.4 GB; 1920 x 1080 takes about 1 s on a loaded machine.
+MAX_CAMERA_PIXELS = 2048 * 2048
 CAMERA_SENSOR_PARAMS = (
-    non_negative("update_rate", float, 0.0, "frames per sim second; 0 = the plugin's updateRate, else 30",
-                 warn_if_missing=False),
-    Param("camera/horizontal_fov", float, 1.047, "rad", minimum=0, exclusive_minimum=True, maximum=3.1416,
+    rate("update_rate", 0.0, "frames per sim second; 0 = the plugin's updateRate, else 30",
+         warn_if_missing=False),
+    Param("camera/horizontal_fov", float, 1.047, "rad (SDF's minimum 0.1)", minimum=0.1, maximum=3.1416,
           warn_if_missing=False),
     Param("camera/image/width", int, 320, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
     Param("camera/image/height", int, 240, "pixels", minimum=1, maximum=8192, warn_if_missing=False),
@@ -70,8 +73,8 @@ CAMERA_PARAMS = (
     Param("imageTopicName", str, "image_raw", "sensor_msgs/Image", warn_if_missing=False),
     Param("cameraInfoTopicName", str, "camera_info", "sensor_msgs/CameraInfo", warn_if_missing=False),
     Param("frameName", str, "", "frame_id of every message", warn_if_missing=False),
-    non_negative("updateRate", float, 0.0, "Hz throttle on top of the sensor update_rate; 0 = every frame",
-                 warn_if_missing=False),
+    rate("updateRate", 0.0, "Hz throttle on top of the sensor update_rate; 0 = every frame",
+         warn_if_missing=False),
     Param("hackBaseline", float, 0.0, "P[3] = -f * hackBaseline", warn_if_missing=False),
     non_negative("focalLength", float, 0.0, "0 = width / (2 tan(hfov/2))", warn_if_missing=False),
     Param("Cx", float, 0.0, "0 = (width + 1) / 2", warn_if_missing=False),
@@ -110,6 +113,11 @@ def parse_camera_sensor(sensor: ET.Element, link: str, document: XmlDocument) ->
     if values["camera/clip/far"] <= values["camera/clip/near"]:
         raise ConfigError(f"{where}: {label}: <clip><far> ({values['camera/clip/far']}) must exceed <clip><near> "
                           f"({values['camera/clip/near']})")
+    width, height = values["camera/image/width"], values["camera/image/height"]
+    if width * height > MAX_CAMERA_PIXELS:
+        raise ConfigError(f"{where}: {label}: <image> {width} x {height} is {width * height:,} pixels; a camera "
+                          f"renders at most {MAX_CAMERA_PIXELS:,} (2048 x 2048) per frame, with the simulation "
+                          "waiting for it")
     noisy = gaussian_noise(sensor.find("camera/noise"), values["camera/noise/type"], f"{where}: {label}", "the image")
     stddev = values["camera/noise/stddev"] if noisy else None
     if sensor.find("camera/distortion") is not None:

@@ -56,6 +56,8 @@ _SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)
 # kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
 _MAX_MASS = 1e9
 _MAX_INERTIA = 1e9
+# A joint axis shorter than this is taken for none (normalising it would lose all precision).
+_MIN_AXIS_LENGTH = 1e-6
 
 
 @dataclass
@@ -306,20 +308,39 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         other = next((j.name for j in joints.values() if j.child == child.get("link")), None)
         if other is not None:
             raise ModelError(f"{where}: child link '{child.get('link')}' already has a parent joint, '{other}'")
-        axis = element.find("axis")
-        joints[joint_name] = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
-                                   read_origin(element, document),
-                                   read_attribute_numbers(axis, "xyz", document, (0.0, 0.0, 0.0))
-                                   if axis is not None else (1.0, 0.0, 0.0),
-                                   safety=_safety_controller(element, where, document),
-                                   mimic=_mimic(element, where, document),
-                                   **_joint_limits(element, joint_type, document))
+        axis_element = element.find("axis")
+        axis = (read_attribute_numbers(axis_element, "xyz", document, (0.0, 0.0, 0.0))
+                if axis_element is not None else (1.0, 0.0, 0.0))
+        # ODE refuses to normalise a zero axis (dNormalize3); Bullet divides by it and the robot turns NaN.
+        if joint_type in MOVABLE_JOINT_TYPES and not math.hypot(*axis) >= _MIN_AXIS_LENGTH:
+            raise ModelError(f"{document.where(axis_element)}: joint '{joint_name}': "
+                             f"<axis xyz=\"{axis_element.get('xyz')}\"> has no direction; "
+                             f"a {joint_type} joint needs an axis of length at least {_MIN_AXIS_LENGTH:g}")
+        limit = element.find("limit")
+        if limit is None and joint_type in ("revolute", "prismatic"):
+            # urdfdom's own rule; PyBullet said only "Cannot load URDF file", naming the robot.
+            raise ModelError(f"{document.where(element)}: joint '{joint_name}' is of type {joint_type} but it does not "
+                             f"specify limits (<limit lower upper effort velocity>)")
+        joints[joint_name] = joint = Joint(joint_name, joint_type, parent.get("link"), child.get("link"),
+                                           read_origin(element, document), axis,
+                                           safety=_safety_controller(element, where, document),
+                                           mimic=_mimic(element, where, document),
+                                           **_joint_limits(element, joint_type, document))
+        if joint.lower > joint.upper:
+            raise ModelError(f"{document.where(limit)}: joint '{joint_name}': <limit lower=\"{joint.lower:g}\"> is "
+                             f"above upper=\"{joint.upper:g}\"")
 
     for joint in joints.values():
         if joint.mimic is not None and (joint.mimic[0] not in joints or not joints[joint.mimic[0]].movable
                                         or not joint.movable):
             raise ModelError(f"{source} joint '{joint.name}': <mimic joint='{joint.mimic[0]}'> needs a movable joint "
                              f"mimicking a movable joint of the robot")
+        followed = [joint.name]
+        while joints[followed[-1]].mimic is not None:
+            followed.append(joints[followed[-1]].mimic[0])
+            if followed[-1] in followed[:-1]:
+                raise ModelError(f"{source} joint '{joint.name}': <mimic> joints follow each other in a circle: "
+                                 f"{' -> '.join(followed)}; one of them must follow a joint that is driven")
     children = {joint.child for joint in joints.values()}
     roots = [link_name for link_name in links if link_name not in children]
     if len(roots) != 1:
@@ -598,7 +619,9 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
     """The URDF handed to PyBullet: fixed joints lumped as Gazebo does (masses, visuals and collisions moved into
     the holder, a separate surface kept on a massless link of its own), no <gazebo>/<transmission>, dropped
     links removed, shapes, origins and inertials checked."""
-    checked = copy.deepcopy(root)
+    # Copied without the blocks PyBullet does not read: a description of 700,000 <gazebo> blocks is mostly them.
+    checked = ElementTree.Element(root.tag, root.attrib)
+    checked.extend(copy.deepcopy(element) for element in root if element.tag not in ("gazebo", "transmission"))
     _check_links(root, checked, document, source)
     elements = {element.get("name"): element for element in checked.findall("link")}
     robot = ElementTree.Element("robot", name=root.get("name") or "robot")

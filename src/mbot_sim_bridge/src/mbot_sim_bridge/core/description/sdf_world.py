@@ -20,8 +20,8 @@ from .mesh import TriangleMesh, load_mesh
 from .model_path import MODEL_MANIFESTS, default_model_path, find_model_directory
 from .world_description import (SHAPE_KINDS, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
-from ..xml_values import (XmlDocument, parse_xml, read_bool, read_bool_attribute, read_number, read_pose,
-                          read_text, read_vector, read_xml_file)
+from ..xml_values import (XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute, read_number,
+                          read_pose, read_text, read_vector, read_xml_file)
 
 _log = get_logger(__name__)
 
@@ -51,6 +51,9 @@ _LINK_IGNORED = {"pose", "inertial", "visual", "sensor", "self_collide", "enable
                  "velocity_decay", "frame", "projector", "audio_sink", "audio_source", "battery", "light",
                  "particle_emitter"}
 _LINK_DEFAULTS_REQUIRED = {"gravity": True, "kinematic": False}  # other values change the motion
+# A dynamic link's mass (kg) and principal moments (kg m^2): the upper ends as the URDF checks' (robot_model.py).
+_MASS_RANGE = (1e-6, 1e9)
+_MOMENT_RANGE = (1e-12, 1e9)
 _GEOMETRY_UNSUPPORTED = {"heightmap", "image", "polyline", "capsule", "ellipsoid"}
 
 
@@ -309,7 +312,8 @@ class _WorldParser:
             if child.tag not in _LINK_IGNORED and child.tag not in _LINK_DEFAULTS_REQUIRED and child.tag != "collision":
                 self._warn_unknown(document, child, "link")
         pose = scope.frame(name, document, link)
-        mass, inertia, inertial_pose = self._inertial(link.find("inertial"), document, static)
+        mass, inertia, inertial_pose = self._inertial(link.find("inertial"), document, static,
+                                                      f"link '{name}' of model '{model}'")
         visual_materials = (sdf_material_rgba(visual.find("material")) for visual in link.findall("visual"))
         rgba = next((colour for colour in visual_materials if colour is not None), None)
         collisions = (self._collision(collision, document, scope, name, static, model, prefix + name, rgba)
@@ -318,17 +322,35 @@ class _WorldParser:
                                tuple(shape for shape in collisions if shape is not None))
 
     @staticmethod
-    def _inertial(inertial: Optional[ET.Element], document: XmlDocument, static: bool):
-        """Mass, inertia and its pose; SDF defaults are mass 1 and unit moments, a static model weighs nothing."""
+    def _inertial(inertial: Optional[ET.Element], document: XmlDocument, static: bool, label: str):
+        """Mass, inertia and its pose; SDF defaults are mass 1 and unit moments, a static model weighs nothing.
+
+        As sdformat's MassMatrix3::IsValid, a dynamic link needs a positive mass and principal moments that are
+        positive and satisfy the triangle inequality; beyond that, Bullet's solver turned a mass or moment far
+        from ``_MASS_RANGE``/``_MOMENT_RANGE`` NaN, so those are refused too."""
         if static:
             return 0.0, (0.0,) * 6, IDENTITY
         if inertial is None:
             return 1.0, (1.0, 0.0, 0.0, 1.0, 0.0, 1.0), IDENTITY
-        mass = read_number(inertial, "mass", document, 1.0)
+
+        def number(parent: ET.Element, tag: str, default: float, minimum: float, maximum: float) -> float:
+            value = read_number(parent, tag, document, default)
+            try:
+                check_range(value, minimum, maximum)
+            except ValueError as problem:
+                raise document.fail(parent.find(tag), f"{label}: <{tag}>: {problem}") from None
+            return value
+        mass = number(inertial, "mass", 1.0, *_MASS_RANGE)
         tensor = inertial.find("inertia")
         defaults = {"ixx": 1.0, "ixy": 0.0, "ixz": 0.0, "iyy": 1.0, "iyz": 0.0, "izz": 1.0}
-        inertia = tuple(read_number(tensor, key, document, value) if tensor is not None else value
-                        for key, value in defaults.items())
+        inertia = tuple(number(tensor, key, value, -_MOMENT_RANGE[1], _MOMENT_RANGE[1])
+                        if tensor is not None else value for key, value in defaults.items())
+        ixx, ixy, ixz, iyy, iyz, izz = inertia
+        moments = sorted(np.linalg.eigvalsh(np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])))
+        if moments[0] < _MOMENT_RANGE[0] or moments[0] + moments[1] < moments[2] * (1.0 - 1e-6):
+            raise document.fail(tensor, f"{label}: <inertia> has principal moments "
+                                        f"{', '.join(f'{m:g}' for m in moments)}; they must be at least "
+                                        f"{_MOMENT_RANGE[0]:g} kg m^2 and each at most the sum of the other two")
         pose = inertial.find("pose")
         return mass, inertia, IDENTITY if pose is None else read_pose(pose, document)
 

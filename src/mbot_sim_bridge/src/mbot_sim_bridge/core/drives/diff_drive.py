@@ -12,7 +12,7 @@ from typing import Tuple
 from .. import names
 from ..clock import UpdateTimer
 from ..geometry import Pose
-from ..params import Param, non_negative
+from ..params import Param, non_negative, rate
 from ..plugin import Plugin
 from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
@@ -32,7 +32,7 @@ DIFF_DRIVE_PARAMS = (
     Param("wheelDiameter", float, 0.15, "wheel diameter (m)", minimum=MINIMUM_WHEEL_SIZE),
     non_negative("wheelTorque", float, 5.0, "maximum torque of each wheel motor (N·m)"),
     non_negative("wheelAcceleration", float, 0.0, "rim acceleration limit (m/s²); 0 = none"),
-    Param("updateRate", float, 100.0, "odometry and command rate (Hz, sim time); ≤ 0 = every physics step"),
+    rate("updateRate", 100.0, "odometry and command rate (Hz, sim time); ≤ 0 = every physics step", signed=True),
     Param("odometrySource", str, "world", "world: ground truth; encoder: integrated wheel odometry",
           choices=("world", "encoder")),
     Param("leftJoint", str, "left_joint", "joint named 'left' by the plugin"),

@@ -13,8 +13,9 @@ from typing import Optional
 
 from .. import names
 from ..clock import UpdateTimer
+from ..engine import MAX_SPEED
 from ..geometry import yaw
-from ..params import Param
+from ..params import Param, rate
 from ..plugin import Plugin
 from .twist_drive import DriveOdometry, TwistCommand, yaw_rotated_velocity
 
@@ -24,13 +25,14 @@ class PlanarMove(TwistCommand, Plugin):
     NAMESPACE_RULE = names.ROOT
     GAZEBO_CLASS = "PlanarMovePlugin"
     COMMAND_AXES = ("linear.x", "linear.y", "angular.z")
+    COMMAND_LIMIT = MAX_SPEED  # set_model_state's cap: 1e10 m/s sent the base 50 m backwards in one step
     PARAMS = (
         Param("robotNamespace", str, "", "namespace of the topics", warn_if_missing=False),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist: linear.x, linear.y (robot frame), angular.z"),
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry (ground truth)"),
         Param("odometryFrame", str, "odom", "frame_id of the odometry and parent of the TF"),
         Param("robotBaseFrame", str, "base_footprint", "child frame of the odometry and the TF"),
-        Param("odometryRate", float, 20.0, "Hz of sim time; <= 0 = no odometry"),
+        rate("odometryRate", 20.0, "Hz of sim time; <= 0 = no odometry", signed=True),
         Param("cmdTimeout", float, -1.0, "s without a command before it is zeroed; < 0 = never"),
     )
     needs_every_step = True

@@ -11,8 +11,9 @@ from typing import Optional
 
 from .. import names
 from ..clock import UpdateTimer
-from ..params import Param, non_negative, positive
+from ..params import Param, non_negative, rate
 from ..plugin import Plugin
+from .diff_drive import MINIMUM_WHEEL_SIZE
 from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
 WHEEL_TAGS = ("leftFrontJoint", "rightFrontJoint", "leftRearJoint", "rightRearJoint")
@@ -29,14 +30,14 @@ class SkidSteerDrive(TwistCommand, Plugin):
         Param("rightFrontJoint", str, "right_front_joint", "wheel joint"),
         Param("leftRearJoint", str, "left_rear_joint", "wheel joint"),
         Param("rightRearJoint", str, "right_rear_joint", "wheel joint"),
-        positive("wheelSeparation", float, 0.4, "m between the left and right wheels"),
-        positive("wheelDiameter", float, 0.15, "m"),
+        Param("wheelSeparation", float, 0.4, "m between the left and right wheels", minimum=MINIMUM_WHEEL_SIZE),
+        Param("wheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
         non_negative("torque", float, 5.0, "N·m, the most each wheel motor gives"),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist subscribed"),
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry (ground truth)"),
         Param("odometryFrame", str, "odom", "frame_id of the odometry"),
         Param("robotBaseFrame", str, "base_footprint", "child_frame_id of the odometry"),
-        Param("updateRate", float, 100.0, "Hz of sim time; <= 0 = every physics step"),
+        rate("updateRate", 100.0, "Hz of sim time; <= 0 = every physics step", signed=True),
         non_negative("covariance_x", float, 0.0001, "pose and twist covariance of x"),
         non_negative("covariance_y", float, 0.0001, "pose and twist covariance of y"),
         non_negative("covariance_yaw", float, 0.01, "pose and twist covariance of yaw"),

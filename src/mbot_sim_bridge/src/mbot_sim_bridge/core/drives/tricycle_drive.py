@@ -24,9 +24,10 @@ from .. import names
 from ..clock import UpdateTimer
 from ..geometry import pose_from_xyz_rpy
 from ..log import get_logger, warn_once
-from ..params import Param, non_negative, positive
+from ..params import Param, non_negative, rate
 from ..plugin import Plugin
 from ..ros_control.hardware_interface import UNBOUNDED_EFFORT
+from .diff_drive import MINIMUM_WHEEL_SIZE
 from .twist_drive import DriveOdometry, TwistCommand, ground_truth_odometry
 
 _logger = get_logger(__name__)
@@ -46,16 +47,16 @@ class TricycleDrive(TwistCommand, Plugin):
         Param("actuatedWheelJoint", str, "front_wheel_joint", "the driven wheel's joint"),
         Param("encoderWheelLeftJoint", str, "left_wheel_joint", "left encoder wheel's joint"),
         Param("encoderWheelRightJoint", str, "right_wheel_joint", "right encoder wheel's joint"),
-        positive("actuatedWheelDiameter", float, 0.15, "m"),
-        positive("encoderWheelDiameter", float, 0.15, "m"),
-        positive("encoderWheelSeparation", float, 0.5, "m between the encoder wheels"),
+        Param("actuatedWheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
+        Param("encoderWheelDiameter", float, 0.15, "m", minimum=MINIMUM_WHEEL_SIZE),
+        Param("encoderWheelSeparation", float, 0.5, "m between the encoder wheels", minimum=MINIMUM_WHEEL_SIZE),
         non_negative("wheelTorque", float, 5.0, "N·m, the most the wheel and the steering motors give"),
         Param("commandTopic", str, "cmd_vel", "geometry_msgs/Twist: linear.x wheel speed, angular.z steering angle"),
         Param("odometryTopic", str, "odom", "nav_msgs/Odometry"),
         Param("odometryFrame", str, "odom", "frame_id of the odometry and parent of the TF"),
         Param("robotBaseFrame", str, "base_link", "child frame of the odometry and the TF"),
         Param("odometrySource", str, "world", "world (ground truth) or encoder", choices=ODOMETRY_SOURCES),
-        Param("updateRate", float, 100.0, "Hz of sim time; <= 0 = every physics step"),
+        rate("updateRate", 100.0, "Hz of sim time; <= 0 = every physics step", signed=True),
         non_negative("wheelAcceleration", float, 0.0, "rad/s² when slowing; 0 = no limit"),
         non_negative("wheelDeceleration", float, None, "rad/s² when speeding up; absent: wheelAcceleration",
                      warn_if_missing=False),

@@ -41,6 +41,7 @@ class TwistCommand:
     linear.y between them). With ``command_timeout`` ≥ 0 (sim seconds), ``command(now)`` is zero once no command
     came for that long, counted from the first step that saw it."""
     COMMAND_AXES: Tuple[str, ...] = ("linear.x", "angular.z")
+    COMMAND_LIMIT = math.inf  # m/s and rad/s; a command beyond it is refused as a non-finite one is
     command_timeout = -1.0
 
     def __init__(self, *args, **kwargs):
@@ -49,10 +50,11 @@ class TwistCommand:
         self.stop()
 
     def set_command(self, *values: float) -> bool:
-        """Store a body twist (m/s, rad/s); a non-finite one is refused (False) and the last valid one stays."""
+        """Store a body twist (m/s, rad/s); one that is not finite or beyond COMMAND_LIMIT is refused (False) and
+        the last valid one stays."""
         if len(values) != len(self.COMMAND_AXES):
             raise TypeError(f"{type(self).__name__}.set_command takes {', '.join(self.COMMAND_AXES)}")
-        if not all(math.isfinite(value) for value in values):
+        if not all(math.isfinite(value) and abs(value) <= self.COMMAND_LIMIT for value in values):
             return False
         with self._lock:
             self._command = tuple(values)

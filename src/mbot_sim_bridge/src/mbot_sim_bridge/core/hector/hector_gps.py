@@ -21,7 +21,7 @@ from typing import NamedTuple, Optional, Tuple
 from .. import names
 from .hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from ..params import Param, non_negative
+from ..params import Param, rate
 from ..plugin import Plugin
 
 EQUATORIAL_RADIUS = 6378137.0
@@ -67,7 +67,7 @@ class HectorGps(HectorUpdates, Plugin):
         Param("service", int, 0, "NavSatStatus service bits", warn_if_missing=False, minimum=0, maximum=65535),
         Param("useWorldSphericalCoordinates", bool, False, "true: not emulated, the reference tags apply",
               warn_if_missing=False),
-        non_negative("updateRate", float, 4.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 4.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("", 3, "position (m)"),
         *sensor_model_params("velocity", 3, "velocity (m/s)"),
@@ -90,12 +90,13 @@ class HectorGps(HectorUpdates, Plugin):
         self.latest: Optional[GpsReading] = None
 
     def geodetic(self, position) -> Tuple[float, float, float]:
-        """(latitude, longitude, altitude) of a world position, as upstream converts it."""
+        """(latitude, longitude, altitude) of a world position, as upstream converts it, with the longitude
+        wrapped into [-180, 180) as a receiver reports it (near a pole upstream's reached millions of degrees)."""
         x, y, z = position
         cos_h, sin_h = math.cos(self.heading), math.sin(self.heading)
+        longitude = self.params["referenceLongitude"] - math.degrees((-sin_h * x + cos_h * y) / self.radius_east)
         return (self.params["referenceLatitude"] + math.degrees((cos_h * x + sin_h * y) / self.radius_north),
-                self.params["referenceLongitude"] - math.degrees((-sin_h * x + cos_h * y) / self.radius_east),
-                self.params["referenceAltitude"] + z)
+                (longitude + 180.0) % 360.0 - 180.0, self.params["referenceAltitude"] + z)
 
     def update(self, now: float):
         dt = self.elapsed(now)

@@ -26,7 +26,7 @@ from ..geometry import IDENTITY, Pose, Vector, compose, inverse, pose_from_xyz_r
 from .hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer
 from .hector_sensor_model import SensorModel, sensor_model_params
 from ..sensors.body_sensors import read_vector_param
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, rate
 from ..plugin import Plugin
 
 Quaternion = Tuple[float, float, float, float]
@@ -73,7 +73,7 @@ class HectorImu(HectorUpdates, Plugin):
                      warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, no effect (as upstream)", warn_if_missing=False),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation", warn_if_missing=False),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("accel", 3, "acceleration (m/s²)"),
         *sensor_model_params("rate", 3, "angular rate (rad/s)"),

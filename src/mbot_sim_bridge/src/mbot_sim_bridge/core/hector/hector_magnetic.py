@@ -18,7 +18,7 @@ from .. import names
 from ..geometry import rotation_matrix
 from .hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, body_link, update_timer, warn_world_coordinates
 from .hector_sensor_model import SensorModel, sensor_model_params
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, rate
 from ..plugin import Plugin
 
 
@@ -46,7 +46,7 @@ class HectorMagnetic(HectorUpdates, Plugin):
               warn_if_missing=False),
         Param("useWorldSphericalCoordinates", bool, False, "true: not emulated, referenceHeading applies",
               warn_if_missing=False),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("", 3, "field"),
     )

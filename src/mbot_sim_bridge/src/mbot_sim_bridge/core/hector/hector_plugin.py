@@ -6,15 +6,14 @@ from typing import Optional, Tuple
 from ..clock import UpdateTimer
 from ..errors import ConfigError
 from ..log import get_logger, warn_once
-from ..params import non_negative
+from ..params import period
 from ..sensors.body_sensors import gazebo_body
 from .hector_sensor_model import SensorModel
 
 _logger = get_logger(__name__)
 
 HECTOR_UPDATE_PARAMS = (
-    non_negative("updatePeriod", float, 0.0, "s between updates; overrides updateRate when given",
-                 warn_if_missing=False),
+    period("updatePeriod", 0.0, "s between updates; overrides updateRate when given", warn_if_missing=False),
 )
 
 

@@ -7,12 +7,12 @@ the diff drive), so robot_state_publisher would not see the simulated joints.
 from .. import names
 from ..clock import UpdateTimer
 from ..errors import ConfigError
-from ..params import Param
+from ..params import Param, rate
 from ..plugin import Plugin
 
 JOINT_STATE_PARAMS = (
     Param("jointName", str, "", "joints to publish, separated by commas"),
-    Param("updateRate", float, 100.0, "Hz of sim time; ≤ 0 = every physics step"),
+    rate("updateRate", 100.0, "Hz of sim time; ≤ 0 = every physics step", signed=True),
     Param("robotNamespace", str, "", "namespace of joint_states; spawn_model sets it", warn_if_missing=False),
 )
 

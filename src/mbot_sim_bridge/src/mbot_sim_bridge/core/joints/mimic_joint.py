@@ -19,7 +19,7 @@ from ..errors import ConfigError
 from ..params import ERROR_MODEL_LIMIT, Param, non_negative
 from ..plugin import Plugin
 from ..ros_control.control_toolbox import Pid, clamp
-from ..ros_control.hardware_interface import UNBOUNDED_EFFORT
+from ..ros_control.hardware_interface import MAX_JOINT_SPEED, UNBOUNDED_EFFORT
 
 
 class MimicJoint(Plugin):
@@ -47,6 +47,7 @@ class MimicJoint(Plugin):
         self.params = params = self.read_params()
         self.leader, self.follower = self.named_joints(params, ("joint", "mimicJoint"))
         joint = context.robot.model.joints[self.follower]
+        self.lower, self.upper = joint.lower, joint.upper  # -inf and inf for a joint without limits
         self.max_effort = params["maxEffort"] if params["maxEffort"] is not None else (
             joint.effort if joint.effort > 0 else math.inf)
         self.pid = None
@@ -64,11 +65,14 @@ class MimicJoint(Plugin):
     def drive(self, step_size: float):
         robot, params = self.context.robot, self.params
         (leader, leader_speed, _), (follower, _, _) = robot.joint_state([self.leader, self.follower])
-        target = leader * params["multiplier"] + params["offset"]
+        # Held to the follower's travel: a target far past it (a multiplier of 1e6) flung the whole robot away.
+        target = clamp(leader * params["multiplier"] + params["offset"], self.lower, self.upper)
         if abs(target - follower) < params["sensitiveness"]:
             return
         if self.pid is None:
-            robot.set_joint_position(self.follower, target, UNBOUNDED_EFFORT, leader_speed * params["multiplier"])
+            speed = 0.0 if target in (self.lower, self.upper) else clamp(leader_speed * params["multiplier"],
+                                                                         -MAX_JOINT_SPEED, MAX_JOINT_SPEED)
+            robot.set_joint_position(self.follower, target, UNBOUNDED_EFFORT, speed)
         else:
             limit = min(self.max_effort, UNBOUNDED_EFFORT)
             robot.set_joint_effort(self.follower, clamp(self.pid.compute(target - follower, step_size), -limit, limit))

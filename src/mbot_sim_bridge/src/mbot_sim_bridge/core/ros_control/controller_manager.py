@@ -51,6 +51,7 @@ class ControllerManager:
         self._updates: List[Callable[[float, float], None]] = []
         self._lock = threading.RLock()
         self._switch_request: Optional[Tuple[list, list, threading.Event]] = None
+        self.closed = False  # unload_all ran: the model is gone, and a switch can no longer be carried out
 
     # -- service side ------------------------------------------------------------------------------------
     def find(self, name: str) -> Optional[LoadedController]:
@@ -161,9 +162,9 @@ class ControllerManager:
             self._switch_request = (stop_list, start_list, done)
         if wait is None:
             done.wait()
-            return True
+            return not self.closed
         if wait(done, timeout):
-            return True
+            return not self.closed
         self._switch_request = None
         return False
 
@@ -193,6 +194,13 @@ class ControllerManager:
                 loaded.controller.close()
             self.controllers = []
             self._updates = []
+            self.closed = True
+            if self._switch_request is not None:
+                # Its caller waits for the loop, which will not run this manager again: answered, not carried out.
+                _logger.error("Controller Manager: the model was deleted before the pending controller switch ran; "
+                              "nothing was switched")
+                self._switch_request[2].set()
+                self._switch_request = None
 
     # -- loop side ---------------------------------------------------------------------------------------
     def update(self, now: float, period: float, reset_controllers: bool = False):

@@ -19,7 +19,7 @@ from typing import Dict, List, Set
 from .. import names
 from ..log import get_logger, warn_once
 from ..parameters import absolute_name
-from ..params import Param
+from ..params import Param, period
 from ..plugin import Plugin
 from ..description.robot_model import RobotModel, parse_robot
 from .controller_table import CORE_CONTROLLERS
@@ -39,8 +39,8 @@ GAZEBO_ROS_CONTROL_PARAMS = (
           "spawn_model sets it", warn_if_missing=False),
     Param("robotParam", str, "robot_description", "parameter holding the URDF (searched up from robotNamespace)",
           warn_if_missing=False),
-    Param("controlPeriod", float, 0.0, "controller update period (s); absent = the physics step",
-          warn_if_missing=False, minimum=0.0),
+    period("controlPeriod", 0.0, "controller update period (s); absent = the physics step",
+           warn_if_missing=False),
     Param("robotSimType", str, "gazebo_ros_control/DefaultRobotHWSim", "robot hardware simulation",
           warn_if_missing=False, choices=tuple(ROBOT_HW_SIMS)),
     Param("legacyModeNS", bool, False, "Kinetic's absolute /gazebo_ros_control/pid_gains namespace when true "

@@ -389,8 +389,11 @@ class JointTrajectoryController(Controller):
             names = list(goal.trajectory.joint_names)
             if ((not self.allow_partial_joints_goal and len(names) != len(self.joint_names))
                     or not self._mapping(names)):
-                _logger.error(f"{self.name}: Joints on incoming goal don't match the controller joints.")
-                return False, INVALID_JOINTS, ""
+                # Upstream's words; upstream leaves the error_string empty, the log alone says why.
+                error = (f"Joints on incoming goal don't match the controller joints: got [{', '.join(names)}], "
+                         f"the controller has [{', '.join(self.joint_names)}]")
+                _logger.error(f"{self.name}: {error}")
+                return False, INVALID_JOINTS, error
             ok, error = self._update_trajectory(goal.trajectory, goal)
             if not ok:
                 return False, INVALID_GOAL, error
@@ -408,8 +411,10 @@ class JointTrajectoryController(Controller):
                 self.ended.append(GoalEnd(goal, CANCELED))
 
     def _mapping(self, names: Sequence[str]) -> Optional[List[int]]:
-        """internal::mapping: where each of ``names`` is among the controller's joints; None if one is not."""
-        if len(names) > len(self.joint_names) or any(name not in self.joint_names for name in names):
+        """internal::mapping: where each of ``names`` is among the controller's joints; None if one is not, or
+        (unlike upstream, which moved the one joint as the last of them said) if one is named twice."""
+        if (len(names) > len(self.joint_names) or any(name not in self.joint_names for name in names)
+                or len(set(names)) < len(names)):
             return None
         return [self.joint_names.index(name) for name in names]
 

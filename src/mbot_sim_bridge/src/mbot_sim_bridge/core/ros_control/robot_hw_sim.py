@@ -26,6 +26,8 @@ _logger = get_logger(__name__)
 _COMMAND_KIND = {EFFORT: "effort", POSITION: "position", VELOCITY: "velocity"}
 # What the engine can carry out, by motor mode (a joint's own limits apply before).
 _ENGINE_BOUND = {"velocity": MAX_JOINT_SPEED, "effort": UNBOUNDED_EFFORT, "position": math.inf}
+# How near its position limit (m or rad) an effort joint pushed outwards counts as resting on the stop.
+STOP_MARGIN = 1e-4
 
 
 @dataclass
@@ -47,6 +49,7 @@ class SimJoint:
     # The last motor setting given to the engine: the body's load count (0: none since the last reset) and value.
     sent_loads: int = field(default=0, repr=False)
     sent_value: float = field(default=0.0, repr=False)
+    on_stop: bool = field(default=False, repr=False)  # pressed against a position limit, held there (write_sim)
 
     @property
     def motor(self) -> str:
@@ -214,10 +217,25 @@ class DefaultRobotHWSim:
             # not sent again; a torque it applies for one step only, so efforts go out every step (as Gazebo's
             # SetForce).
             if motor == "effort":
-                self.robot.set_joint_effort(joint.name, value)
+                self._set_effort(joint, value)
             elif value != joint.sent_value or loads != joint.sent_loads:
                 joint.sent_loads, joint.sent_value = loads, value
                 self._set_motor(joint, motor, value)
+
+    def _set_effort(self, joint: SimJoint, value: float):
+        """The effort for the next step. A joint pushed against its position limit rests on it, as on ODE's
+        stops in Gazebo: Bullet's limit takes hold only once the joint is past it, so the push and the saturation
+        (no outward effort past the limit) made it chatter there at up to 0.4 m/s, and a gripper's stall check
+        never fired. There a zero-velocity motor of that effort holds it instead."""
+        if (value > 0.0 and joint.position >= joint.upper - STOP_MARGIN
+                or value < 0.0 and joint.position <= joint.lower + STOP_MARGIN):
+            joint.on_stop = True
+            self.robot.set_joint_velocity(joint.name, 0.0, abs(value))
+            return
+        if joint.on_stop:
+            joint.on_stop = False
+            self.robot.release_joint(joint.name)
+        self.robot.set_joint_effort(joint.name, value)
 
     def _set_motor(self, joint: SimJoint, motor: str, value: float):
         """A new setting of a position or velocity motor."""

@@ -22,7 +22,7 @@ from .. import names
 from ..clock import UpdateTimer
 from ..geometry import IDENTITY, Pose, Vector, compose, inverse
 from ..log import get_logger, warn_once
-from ..params import Param, PluginParams, non_negative
+from ..params import Param, PluginParams, rate
 from ..plugin import Plugin
 from .sensor_elements import sensor_label
 
@@ -57,7 +57,7 @@ class Bumper(Plugin):
     IGNORED_TAGS = ("alwaysOn", "updateRate")
     SENSOR_TYPES = ("contact",)
     SENSOR_PARAMS = (
-        non_negative("update_rate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("update_rate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         Param("contact/collision", str, None, "the link's collision reported", required=True),
     )
 

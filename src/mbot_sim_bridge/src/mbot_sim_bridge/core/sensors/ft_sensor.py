@@ -21,7 +21,7 @@ from ..clock import UpdateTimer
 from ..errors import ConfigError
 from .body_sensors import IDLE_PERIOD
 from ..geometry import Vector, rotation_matrix
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, rate
 from ..plugin import Plugin
 
 
@@ -41,7 +41,7 @@ class FTSensor(Plugin):
         Param("jointName", str, None, "the movable joint measured", required=True),
         Param("topicName", str, None, "geometry_msgs/WrenchStamped", required=True),
         non_negative("gaussianNoise", float, 0.0, "stddev on each of the six values", maximum=ERROR_MODEL_LIMIT),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
     )
     IGNORED_TAGS = ("alwaysOn",)
 

@@ -40,7 +40,7 @@ from ..clock import EveryStopTimer, UpdateTimer
 from ..errors import ConfigError
 from ..geometry import IDENTITY, Pose, Vector, compose, pose_from_xyz_rpy, quaternion_products, rotation_matrix
 from ..log import get_logger, warn_once
-from ..params import ERROR_MODEL_LIMIT, Param, PluginParams, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, PluginParams, non_negative, rate
 from ..plugin import Plugin
 from .body_sensors import IDLE_PERIOD, gazebo_body, read_vector_param
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
@@ -103,7 +103,7 @@ class ImuModelPlugin(Plugin):
                      warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, no effect in Gazebo", warn_if_missing=False),
         Param("rpyOffset", str, "0 0 0", "rad; pre-multiplies the orientation", warn_if_missing=False),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         Param("frameName", str, None, "frame_id (default: bodyName)", warn_if_missing=False),
     )
     IGNORED_TAGS = ("alwaysOn", "imu")
@@ -245,7 +245,7 @@ class ImuSensor(Plugin):
         Param("robotNamespace", str, None, "absent: /MODEL_NAME/", warn_if_missing=False),
         Param("topicName", str, "imu_data", "sensor_msgs/Imu, relative to the namespace"),
         Param("frameName", str, None, "frame_id", required=True),
-        non_negative("updateRateHZ", float, 1.0, "Hz; publishes no faster than this; 0 = every sensor update"),
+        rate("updateRateHZ", 1.0, "Hz; publishes no faster than this; 0 = every sensor update"),
         non_negative("gaussianNoise", float, 0.0, "stddev on every field; covariance diagonals",
                      maximum=ERROR_MODEL_LIMIT),
         Param("xyzOffset", str, "0 0 0", "read, unused by Gazebo"),
@@ -256,7 +256,7 @@ class ImuSensor(Plugin):
     IGNORED_TAGS = ("alwaysOn",)
     SENSOR_TYPES = ("imu",)
     SENSOR_PARAMS = (
-        non_negative("update_rate", float, 0.0, "Hz; 0 = every physics step", warn_if_missing=False),
+        rate("update_rate", 0.0, "Hz; 0 = every physics step", warn_if_missing=False),
     )
 
     def __init__(self, context, element, sensor):

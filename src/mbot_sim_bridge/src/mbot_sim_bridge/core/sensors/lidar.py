@@ -35,24 +35,31 @@ from ..clock import UpdateTimer
 from ..errors import ConfigError
 from ..geometry import IDENTITY, Pose, compose, rotation_matrix
 from ..log import get_logger, info_once
-from ..params import Param, PluginParams, non_negative, positive
+from ..params import Param, PluginParams, non_negative, positive, rate
 from ..plugin import Plugin
 from .sensor_elements import gaussian_noise, sensor_label, sensor_pose
 from ..xml_values import XmlDocument
 
 _log = get_logger(__name__)
 
+# A ray sensor's angles (rad) at most: far beyond any sweep, and small enough that the ray angles computed from
+# them stay finite (1e308 overflowed).
+MAX_ANGLE = 1e3
 # The <sensor> values of a ray sensor (SDF names and defaults; Gazebo does not warn about missing SDF tags).
 RAY_SENSOR_PARAMS = (
-    non_negative("update_rate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+    rate("update_rate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
     Param("ray/scan/horizontal/samples", int, None, "rays per sweep", required=True, minimum=1),
     positive("ray/scan/horizontal/resolution", float, 1.0, "ranges per ray (interpolated)", warn_if_missing=False),
-    Param("ray/scan/horizontal/min_angle", float, None, "first ray (rad)", required=True),
-    Param("ray/scan/horizontal/max_angle", float, None, "last ray (rad)", required=True),
+    Param("ray/scan/horizontal/min_angle", float, None, "first ray (rad)", required=True, minimum=-MAX_ANGLE,
+          maximum=MAX_ANGLE),
+    Param("ray/scan/horizontal/max_angle", float, None, "last ray (rad)", required=True, minimum=-MAX_ANGLE,
+          maximum=MAX_ANGLE),
     Param("ray/scan/vertical/samples", int, 1, "vertical layers", minimum=1, warn_if_missing=False),
     positive("ray/scan/vertical/resolution", float, 1.0, "ranges per layer", warn_if_missing=False),
-    Param("ray/scan/vertical/min_angle", float, 0.0, "lowest layer (rad)", warn_if_missing=False),
-    Param("ray/scan/vertical/max_angle", float, 0.0, "highest layer (rad)", warn_if_missing=False),
+    Param("ray/scan/vertical/min_angle", float, 0.0, "lowest layer (rad)", warn_if_missing=False,
+          minimum=-MAX_ANGLE, maximum=MAX_ANGLE),
+    Param("ray/scan/vertical/max_angle", float, 0.0, "highest layer (rad)", warn_if_missing=False,
+          minimum=-MAX_ANGLE, maximum=MAX_ANGLE),
     non_negative("ray/range/min", float, None, "rays start here (m)", required=True),
     positive("ray/range/max", float, None, "longest reading (m)", required=True),
     non_negative("ray/range/resolution", float, 0.0, "checked, and without effect, as in Gazebo (no quantizing)",
@@ -171,17 +178,18 @@ def _check_consistency(config: RaySensorConfig, where: str) -> None:
     if config.range_max <= config.range_min:
         raise ConfigError(f"{where}: <range><max> ({config.range_max}) must exceed "
                           f"<range><min> ({config.range_min})")
-    if config.range_count < 1:
-        raise ConfigError(f"{where}: <samples> × <resolution> = {config.samples * config.resolution} "
-                          f"leaves no ranges")
-    if config.vertical_range_count < 1:
-        raise ConfigError(f"{where}: <vertical><samples> × <vertical><resolution> = "
-                          f"{config.vertical_samples * config.vertical_resolution} leaves no ranges")
-    # Compared as floats: the counts of a typo can be too large to turn into arrays, or into ints at all.
-    ranges = config.samples * config.resolution * config.vertical_samples * config.vertical_resolution
-    if ranges > MAX_RANGES_PER_SCAN:
+    # Compared as floats first: the counts of a typo can be too large to turn into arrays, or into ints at all
+    # (a resolution of 1e308 overflowed), each row's as well as their product.
+    rows = (config.samples * config.resolution, config.vertical_samples * config.vertical_resolution)
+    ranges = rows[0] * rows[1]
+    largest = max(rows + (ranges,))
+    if largest > MAX_RANGES_PER_SCAN:
         raise ConfigError(f"{where}: <samples> × <resolution> × <vertical><samples> × <vertical><resolution> = "
-                          f"{ranges:g} ranges per scan; at most {MAX_RANGES_PER_SCAN} are simulated")
+                          f"{largest:g} ranges per scan; at most {MAX_RANGES_PER_SCAN} are simulated")
+    if config.range_count < 1:
+        raise ConfigError(f"{where}: <samples> × <resolution> = {rows[0]} leaves no ranges")
+    if config.vertical_range_count < 1:
+        raise ConfigError(f"{where}: <vertical><samples> × <vertical><resolution> = {rows[1]} leaves no ranges")
 
 
 class RaySensor(Plugin):

@@ -22,7 +22,7 @@ from ..clock import UpdateTimer
 from ..errors import ConfigError
 from ..geometry import Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
 from .body_sensors import IDLE_PERIOD, read_vector_param
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, rate
 from ..plugin import Plugin
 
 WORLD_FRAMES = ("world", "/world", "map", "/map")
@@ -50,7 +50,7 @@ class P3D(Plugin):
         Param("rpyOffset", str, "0 0 0", "rad, pre-multiplies the orientation", warn_if_missing=False),
         non_negative("gaussianNoise", float, 0.0, "stddev on the twist", warn_if_missing=False,
                      maximum=ERROR_MODEL_LIMIT),
-        non_negative("updateRate", float, 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
     )
     IGNORED_TAGS = ("alwaysOn",)
 

@@ -18,7 +18,7 @@ from ..clock import UpdateTimer
 from ..hector.hector_plugin import HECTOR_UPDATE_PARAMS, HectorUpdates, update_timer
 from ..hector.hector_sensor_model import SensorModel, sensor_model_params
 from .lidar import RaySensor
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, rate
 
 ULTRASOUND, INFRARED = 0, 1  # sensor_msgs/Range radiation types
 
@@ -40,8 +40,8 @@ class RangeSensor(RaySensor):
         non_negative("fov", float, 0.05, "rad; the message's field_of_view"),
         non_negative("gaussianNoise", float, 0.0, "m; stddev added to a reading below max_range",
                      warn_if_missing=False, maximum=ERROR_MODEL_LIMIT),
-        non_negative("updateRate", float, 0.0, "Hz throttle on top of the sensor's update_rate; 0 = none",
-                     warn_if_missing=False),
+        rate("updateRate", 0.0, "Hz throttle on top of the sensor's update_rate; 0 = none",
+             warn_if_missing=False),
     )
 
     def __init__(self, context, element, sensor):
@@ -69,7 +69,7 @@ class HectorSonar(HectorUpdates, RaySensor):
         Param("robotNamespace", str, "", "namespace of the topic", warn_if_missing=False),
         Param("topicName", str, "sonar", "sensor_msgs/Range", warn_if_missing=False),
         Param("frameId", str, "/sonar_link", "frame_id, as given", warn_if_missing=False),
-        non_negative("updateRate", float, 10.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
+        rate("updateRate", 10.0, "Hz of sim time; 0 = every physics step", warn_if_missing=False),
         *HECTOR_UPDATE_PARAMS,
         *sensor_model_params("", 1, "range (m)"),
     )

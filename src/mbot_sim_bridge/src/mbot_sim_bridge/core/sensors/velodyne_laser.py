@@ -16,8 +16,9 @@ from typing import NamedTuple, Optional
 import numpy as np
 
 from .. import names
+from ..errors import ConfigError
 from .lidar import RaySensor
-from ..params import ERROR_MODEL_LIMIT, Param, non_negative
+from ..params import ERROR_MODEL_LIMIT, Param, non_negative, positive
 
 
 class VelodyneCloud(NamedTuple):
@@ -39,7 +40,7 @@ class VelodyneLaser(RaySensor):
         Param("frameName", str, "/world", "frame_id, resolved with the tf prefix", warn_if_missing=False),
         Param("topicName", str, "/points", "sensor_msgs/PointCloud2", warn_if_missing=False),
         non_negative("min_range", float, 0.0, "m; nearer readings are dropped", warn_if_missing=False),
-        non_negative("max_range", float, math.inf, "m; farther readings are dropped", warn_if_missing=False),
+        positive("max_range", float, math.inf, "m; farther readings are dropped", warn_if_missing=False),
         Param("min_intensity", float, -math.inf, "readings of less intensity are dropped (intensity is 0 here)",
               warn_if_missing=False),
         non_negative("gaussianNoise", float, 0.0, "m; stddev added to each kept range", warn_if_missing=False,
@@ -53,6 +54,10 @@ class VelodyneLaser(RaySensor):
         config = self.config
         self.min_range = max(self.params["min_range"], config.range_min)
         self.max_range = min(self.params["max_range"], config.range_max)
+        if self.min_range >= self.max_range:
+            raise ConfigError(f"{context.where(element)}: {self.label}: readings are kept between <min_range> "
+                              f"{self.params['min_range']:g} (or the ray's min {config.range_min:g}) and <max_range> "
+                              f"{self.params['max_range']:g} (or the ray's max {config.range_max:g}): none would be")
         self.noise_rng = context.random_stream(f"{config.sensor_name}/velodyne")
 
         def angles(count, low, high, rays):
@@ -85,7 +90,9 @@ class VelodyneLaser(RaySensor):
             ranges = ranges + self.noise_rng.normal(0.0, noise, ranges.size)
         # Organised, upstream checks the noisy range only: a ray dropped by the first check can come back.
         valid = (kept | organized) & (self.min_range < ranges) & (ranges < self.max_range)
-        xyz = (self.directions * ranges[:, np.newaxis]).astype(np.float32)
+        # Rays with no reading (an infinite range) are left out or made NaN below; multiplied out, inf times a
+        # direction's zero component gave NaN warnings first (a sweep ending at 0 rad has such directions).
+        xyz = (self.directions * np.where(valid, ranges, 0.0)[:, np.newaxis]).astype(np.float32)
         if organized:
             xyz[~valid] = np.nan
             intensity = np.where(valid, intensity, np.nan).astype(np.float32)
