@@ -11,6 +11,7 @@ This takes over the part of rospy's ``_PublisherImpl.publish`` that serializes a
 header.seq, the length prefix, statistics), for publishers that are neither latched nor queued; a rospy
 Publisher has no hook for writing elsewhere.
 """
+import errno
 import socket
 import struct
 import subprocess
@@ -87,8 +88,10 @@ class LoopPublishing:
         return [] if impl.closed else [connection for connection in impl.connections if not connection.done]
 
     def _append(self, impl, connections: list, data: bytes, count: int):
+        ids = [number for number in (self._id(connection, impl) for connection in connections) if number is not None]
+        if not ids:
+            return
         impl.message_data_sent += len(data)
-        ids = [self._id(connection, impl) for connection in connections]
         if not self._batch:
             self._batch_started = time.monotonic()
         self._batch += DATA_HEADER.pack(DATA, len(ids), len(data))
@@ -98,18 +101,26 @@ class LoopPublishing:
             connection.stat_bytes += len(data)
             connection.stat_num_msg += count
 
-    def _id(self, connection, impl) -> int:
+    def _id(self, connection, impl) -> Optional[int]:
+        """The writer's number for ``connection``; None while rospy is closing it (it closes the socket before
+        it marks the connection done, so a new subscriber that leaves at once has no descriptor to hand over)."""
         known = self._ids.get(connection)
         if known is not None:
             return known[0]
+        sock = connection.socket
+        descriptor = -1 if sock is None else sock.fileno()
+        if descriptor < 0:
+            return None
         number = self._next_id
-        self._next_id += 1
         # The descriptor travels with its OPEN frame, so everything batched before it goes first.
         self._send_batch()
         try:
-            socket.send_fds(self._channel, [ID.pack(OPEN, number)], [connection.socket.fileno()])
+            socket.send_fds(self._channel, [ID.pack(OPEN, number)], [descriptor])
         except OSError as error:
+            if error.errno == errno.EBADF:  # closed by rospy since fileno(): that subscriber has gone
+                return None
             self._failure = self._failure or error
+        self._next_id += 1
         self._ids[connection] = (number, impl)
         self._connections[number] = connection
         return number

@@ -106,10 +106,14 @@ def print_outcomes():
     for kind, counts in OUTCOMES.items():
         details = ", ".join(f"{count} {outcome}" for outcome, count in sorted(counts.items()))
         print(f"figure: fuzz {kind}: {sum(counts.values())} cases: {details}")
-    for kind, counts in OUTCOMES.items():
-        assert_outcome_mix(kind, counts)
+    for kind in MIXED_OUTCOMES:
+        if kind in OUTCOMES:  # a run narrowed with -k may leave a fuzzer out
+            assert_outcome_mix(kind, OUTCOMES[kind])
 
 
+# The fuzzers whose draws must be partly refused and partly carried out (the extreme-value, link-count and gripper
+# sweeps walk fixed lists whose outcomes their own tests check).
+MIXED_OUTCOMES = ("robot descriptions", "worlds", "service requests")
 # The request kinds some generated requests carry out. Not spawn_sdf: its one valid model with seven finite numbers
 # is rare among the draws (none in 150 sequences with the fixed seed).
 REQUEST_KINDS = ("set_model_state", "spawn_robot", "delete", "command", "reset_world", "reset_simulation")

@@ -20,9 +20,9 @@ def on_twist(plugin, message: Twist):
     values = [attrgetter(axis)(message) for axis in plugin.COMMAND_AXES]
     if not plugin.set_command(*values):
         given = ", ".join(f"{axis} {value}" for axis, value in zip(plugin.COMMAND_AXES, values))
-        beyond = f" or beyond {plugin.COMMAND_LIMIT:g}" if math.isfinite(plugin.COMMAND_LIMIT) else ""
-        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a value that is not "
-                                    f"finite{beyond} ({given}); keeping the last valid command")
+        beyond = f" or one beyond {plugin.COMMAND_LIMIT:g}" if math.isfinite(plugin.COMMAND_LIMIT) else ""
+        rospy.logwarn_throttle(5.0, f"{plugin.label}: ignored a {plugin.command_topic} with a non-finite "
+                                    f"value{beyond} ({given}); keeping the last valid command")
 
 
 class OdometryOutput:
