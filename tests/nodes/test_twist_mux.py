@@ -139,6 +139,10 @@ class TwistMuxSystem(unittest.TestCase):
         self.wait_output(twist(1e308, -1e308), "a huge but finite Twist to pass")
         complaints = [text for text in self.warnings if "input3" in text and "dropped" in text]
         self.assertEqual(len(complaints), 1, f"expected one warning for input3, got {complaints}")
+        wait_for(lambda: [text for text in self.warnings if "input3" in text and "forwarded" in text],
+                 what="the warning about input3's huge value")
+        huge = [text for text in self.warnings if "input3" in text and "forwarded" in text]
+        self.assertEqual(len(huge), 1, f"expected one warning about the huge value, got {huge}")
         # A Bool whose byte is 255 reads true: the lock engages.
         self.rates.pub("lock_2", Bool(255))
         self.rates.pub("vel_1", twist(2.0), rate=10)

@@ -93,6 +93,16 @@ def non_finite_field(values: Sequence[float]) -> Optional[Tuple[str, float]]:
     return next(((field, value) for field, value in zip(TWIST_FIELDS, values) if not math.isfinite(value)), None)
 
 
+# m/s and rad/s beyond any vehicle (the simulator's own cap on set speeds): still forwarded, as upstream does, since
+# the base's limits apply, but said once so that a unit or scale mistake upstream of the mux shows.
+HUGE_VALUE = 1.0e4
+
+
+def huge_field(values: Sequence[float]) -> Optional[Tuple[str, float]]:
+    """The first of a Twist's six finite values beyond HUGE_VALUE in magnitude, with its value."""
+    return next(((field, value) for field, value in zip(TWIST_FIELDS, values) if abs(value) > HUGE_VALUE), None)
+
+
 class TwistMux:
     def __init__(self, inputs: Sequence[Handle], locks: Sequence[Handle]):
         self.inputs = list(inputs)

@@ -7,7 +7,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from std_msgs.msg import Bool
 
-from .mux import TwistMux, non_finite_field, parse_handles
+from .mux import HUGE_VALUE, TwistMux, huge_field, non_finite_field, parse_handles
 
 DIAGNOSTICS_PERIOD = 1.0
 # How often a lock that engaged by timing out (its publisher gone) is looked for; a Bool engages it at once.
@@ -60,6 +60,11 @@ class TwistMuxNode:
                             f"({rospy.resolve_name(handle.topic)}): {bad[0]} is {bad[1]}; such messages are "
                             "dropped (said once per input)")
             return
+        huge = huge_field(values)
+        if huge is not None:
+            self._warn_once(("huge", handle.name), f"twist_mux: input '{handle.name}' "
+                            f"({rospy.resolve_name(handle.topic)}): {huge[0]} is {huge[1]:g}, beyond {HUGE_VALUE:g}; "
+                            "forwarded as upstream does, the base's limits apply (said once per input)")
         with self._lock:
             if self.mux.on_twist(handle, rospy.get_time()):
                 self.publisher.publish(message)

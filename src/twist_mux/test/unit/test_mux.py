@@ -1,7 +1,7 @@
 """The selection of twist_mux without ROS: upstream's rules at their edges, and the parameters' errors."""
 import math
 
-from twist_mux.mux import TwistMux, non_finite_field, parse_handles
+from twist_mux.mux import TwistMux, huge_field, non_finite_field, parse_handles
 
 TOPICS = [{"name": "input1", "topic": "vel_1", "timeout": 0.7, "priority": 5},
           {"name": "input2", "topic": "vel_2", "timeout": 0.0, "priority": 1},
@@ -103,3 +103,8 @@ def test_status_is_upstreams_text():
     assert values["velocity input2"] == " unmasked (listening to vel_2 @ 0.000000s with priority #1)"
     assert values["lock emergency_10"] == " free (listening to lock_2 @ 0.000000s with priority #10)"
     assert values["current priority"] == "0"
+
+
+def test_huge_field_names_the_first_beyond_the_limit():
+    assert huge_field((1.0, -2.0, 0, 0, 0, 3.0)) is None
+    assert huge_field((1.0, 1e308, 0, 0, 0, -1e5)) == ("linear.y", 1e308)
