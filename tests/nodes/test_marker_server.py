@@ -84,6 +84,9 @@ class MarkerServer(unittest.TestCase):
         time.sleep(0.2)
         complaints = [text for text in self.warnings if "no Twist sent" in text]
         self.assertEqual(len(complaints), 4, complaints)
+        self.send(feedback(x=-1e308))
+        wait_for(lambda: [text for text in self.warnings if "clamped" in text], what="the huge offset said")
+        self.assertEqual(len([text for text in self.warnings if "clamped" in text]), 1)
 
 
 if __name__ == "__main__":

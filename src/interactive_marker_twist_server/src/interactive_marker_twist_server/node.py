@@ -9,7 +9,7 @@ from geometry_msgs.msg import Pose, Quaternion, Twist
 from interactive_markers.interactive_marker_server import InteractiveMarkerServer
 from visualization_msgs.msg import InteractiveMarker, InteractiveMarkerControl
 
-from .twist_from_pose import AXES, Scales, pose_problem, twist_values
+from .twist_from_pose import AXES, Scales, huge_offset, pose_problem, twist_values
 
 # Each control's orientation (w, x, y, z): the axis a MOVE_AXIS or ROTATE_AXIS control works along.
 _CONTROLS = (("move_x", InteractiveMarkerControl.MOVE_AXIS, (1, 1, 0, 0), "x"),
@@ -104,6 +104,11 @@ class MarkerServer:
                 setattr(twist.linear, axis, value)
             twist.angular.z = angular
             self.publisher.publish(twist)
+            huge = huge_offset(position)
+            if huge is not None and "huge" not in self._warned:
+                self._warned.add("huge")
+                rospy.logwarn(f"marker_server: feedback from {feedback.client_id or 'a client'}: {huge}; the Twist "
+                              "is clamped to the limits (said once)")
         elif problem not in self._warned:
             self._warned.add(problem)
             rospy.logwarn(f"marker_server: feedback from {feedback.client_id or 'a client'} on "

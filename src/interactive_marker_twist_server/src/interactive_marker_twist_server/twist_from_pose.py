@@ -39,6 +39,19 @@ def twist_values(scales: Scales, position: Tuple[float, float, float],
     return linear, angular
 
 
+# Metres of marker offset beyond any drag in rviz: such a pose still gives the clamped Twist, as upstream's does, but
+# is said once, as a sign of a client sending something else than a dragged marker.
+HUGE_OFFSET = 1.0e4
+
+
+def huge_offset(position) -> Optional[str]:
+    """The first position value beyond HUGE_OFFSET in magnitude, described, else None."""
+    for name, value in zip(("position.x", "position.y", "position.z"), position):
+        if abs(value) > HUGE_OFFSET:
+            return f"{name} is {value:g}, beyond {HUGE_OFFSET:g} m"
+    return None
+
+
 def pose_problem(position, orientation) -> Optional[str]:
     """Why a feedback pose cannot give a Twist (a NaN or infinite value, or a zero quaternion), else None."""
     names = ("position.x", "position.y", "position.z", "orientation.x", "orientation.y", "orientation.z",
