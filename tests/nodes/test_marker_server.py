@@ -84,7 +84,9 @@ class MarkerServer(unittest.TestCase):
         time.sleep(0.2)
         complaints = [text for text in self.warnings if "no Twist sent" in text]
         self.assertEqual(len(complaints), 4, complaints)
-        self.send(feedback(x=-1e308))
+        count = self.send(feedback(x=-1e308))
+        wait_for(lambda: len(self.twists) > count, what="the clamped Twist of a second huge pose")
+        self.assertEqual(self.twists[-1].linear.x, -1.0)
         wait_for(lambda: [text for text in self.warnings if "clamped" in text], what="the huge offset said")
         self.assertEqual(len([text for text in self.warnings if "clamped" in text]), 1)
 
