@@ -6,7 +6,6 @@ Arguments go to pytest after the defaults, so ``-k PATTERN``, ``-n 1``, ``--dura
 or change the run. Prints the measurements the tests recorded (``figure`` properties) and one closing line,
 ``summary: N passed, N failed`` counting rostest's test cases one by one; exits non-zero on any failure.
 """
-import glob
 import os
 import subprocess
 import sys
@@ -14,7 +13,6 @@ import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REPORT = os.path.join(ROOT, "build", "test_results", "pytest.xml")
-TEST_ROOTS = ("src/*/test", "tests")
 # Most tests wait on ROS processes rather than compute, so twice as many workers as cores keep both busy;
 # --dist loadgroup hands out tests one by one, keeping together those that share a module-scoped fixture (one
 # simulator shared by a module's tests; see the workspace's conftest.py).
@@ -50,11 +48,9 @@ def main(arguments):
     os.makedirs(os.path.dirname(REPORT), exist_ok=True)
     if os.path.exists(REPORT):
         os.remove(REPORT)
-    roots = [path for pattern in TEST_ROOTS for path in sorted(glob.glob(os.path.join(ROOT, pattern)))]
-    paths_given = any(not argument.startswith("-") and os.path.exists(argument) for argument in arguments)
     command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--rootdir", ROOT,
                "--junitxml", REPORT, "-n", str(WORKERS), "--dist", "loadgroup", "--durations", "10",
-               *arguments, *([] if paths_given else roots)]
+               *arguments]  # without test paths, pytest.ini's testpaths
     code = subprocess.call(command, cwd=ROOT)
     if code == 5:  # nothing selected by the filter
         print("summary: 0 passed, 0 failed")

@@ -8,6 +8,7 @@ topic subscribed; the real-time factor of each and their ratio, the CPU seconds 
 for, and the wall time from roslaunch to the first /odom (median of several launches);
 then ten robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
 (bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
+Every figure goes to results.json, from which the README's speed table is generated (results.py).
 """
 import argparse
 import os
@@ -22,11 +23,15 @@ import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+from results import README, RECORD_ENV, RESULTS, load, recorded, report, with_table, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 STEP = 0.001
 WHEELS = ("left_wheel_joint", "right_wheel_joint")
+# --short: every figure measured over this little time (each script has its own short settings).
+SHORT_SIM_SECONDS = 0.5
+SHORT_WALL_SECONDS = 0.5
 
 
 def raw_pybullet_rtf(sim_seconds: float) -> float:
@@ -129,46 +134,63 @@ def main():
     parser.add_argument("--sim-seconds", type=float, default=20.0, help="sim time of the raw PyBullet run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time the bridge is measured")
     parser.add_argument("--launches", type=int, default=7, help="launches timed to the first /odom")
+    parser.add_argument("--short", action="store_true",
+                        help="every figure with tiny durations (checks that each runs; the figures mean little)")
+    parser.add_argument("--results", metavar="FILE",
+                        help=f"where the figures are written (default {os.path.relpath(RESULTS, WORKSPACE)}, whose "
+                             "README table is then regenerated; --short writes only here)")
     args = parser.parse_args()
+    if args.short:
+        args.sim_seconds, args.wall_seconds, args.launches = SHORT_SIM_SECONDS, SHORT_WALL_SECONDS, 1
     with tempfile.TemporaryDirectory(prefix="mbot_bench_logs_") as logs:
         # Every ROS process of the bench logs here, not into ~/.ros/log: roslaunch measures the size of its log
         # directory (du) at each start, which grows with every run there and would count in the launch times.
         os.environ["ROS_LOG_DIR"] = logs
-        run(args)
+        os.environ[RECORD_ENV] = os.path.join(logs, "figures.jsonl")
+        raw = run(args)
+        if args.results or not args.short:
+            write_results(args.results or RESULTS, recorded(os.environ[RECORD_ENV]), raw, args.short)
+        if not args.results and not args.short:
+            with open(README) as stream:
+                text = stream.read()
+            with open(README, "w") as stream:
+                stream.write(with_table(text, load()))
+            print(f"figures written to {RESULTS} and the speed table of {os.path.normpath(README)}")
 
 
-def run(args):
+def run(args) -> float:
     raw = raw_pybullet_rtf(args.sim_seconds)
-    print(f"raw PyBullet real-time factor: {raw:.2f}", flush=True)
+    report("one mbot, raw PyBullet real-time factor", f"{raw:.2f}")
     with PrivateMaster() as master:
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy and the launches
         rospy.init_node("bench_bridge", disable_signals=True)
         bridge, topics, cpu, cores_busy = bridge_rtf(args.wall_seconds)
-        print(f"bridge real-time factor ({topics} topics subscribed): {bridge:.2f}")
-        print(f"bridge / raw: {bridge / raw:.2f}")
-        print(f"CPU seconds per sim second: raw PyBullet {1 / raw:.4f}; "
-              + ", ".join(f"{kind} {seconds:.4f}" for kind, seconds in sorted(cpu.items(), key=lambda kv: -kv[1]))
-              + f"; cores busy {cores_busy:.2f} of {os.cpu_count()}")
+        report("one mbot, bridge real-time factor", f"{bridge:.2f} ({topics} topics subscribed)")
+        report("one mbot, bridge / raw", f"{bridge / raw:.2f}")
+        report("one mbot, CPU seconds per sim second",
+               f"raw PyBullet {1 / raw:.4f}; "
+               + ", ".join(f"{kind} {seconds:.4f}" for kind, seconds in sorted(cpu.items(), key=lambda kv: -kv[1]))
+               + f"; cores busy {cores_busy:.2f} of {os.cpu_count()}")
         # The ceiling the other processes leave: a bridge costing what raw PyBullet costs, on every core.
         beside = sum(seconds for kind, seconds in cpu.items() if kind != "bridge")
-        print(f"bridge / raw at most, with the processes beside the bridge as measured and a bridge costing what "
-              f"raw PyBullet does: {os.cpu_count() / (1 / raw + beside) / raw:.2f}", flush=True)
+        report("one mbot, bridge / raw at most (the processes beside the bridge as measured, a bridge costing what "
+               "raw PyBullet does)", f"{os.cpu_count() / (1 / raw + beside) / raw:.2f}")
         # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several,
         # each beside a launch of the floor, in turn.
         pairs = [(first_odom_seconds(), first_odom_seconds(LAUNCH_FLOOR)) for _ in range(args.launches)]
         launches, floors = sorted(launch for launch, _ in pairs), sorted(floor for _, floor in pairs)
-        print(f"roslaunch to first /odom: median {statistics.median(launches):.2f} s ({len(launches)} launches, "
-              f"{launches[0]:.2f} to {launches[-1]:.2f} s)")
-        print(f"the same roslaunch with a bare rospy node publishing /odom instead of the simulator and spawn_model "
-              f"(launch_floor.launch): median {statistics.median(floors):.2f} s ({floors[0]:.2f} to "
-              f"{floors[-1]:.2f} s); the simulator's part: median "
-              f"{statistics.median(launch - floor for launch, floor in pairs):.2f} s", flush=True)
+        report("roslaunch to the first /odom", f"median {statistics.median(launches):.2f} s ({len(launches)} "
+               f"launches, {launches[0]:.2f} to {launches[-1]:.2f} s)")
+        report("the same roslaunch with a bare rospy node publishing /odom (launch_floor.launch)",
+               f"median {statistics.median(floors):.2f} s ({floors[0]:.2f} to {floors[-1]:.2f} s); the simulator's "
+               f"part: median {statistics.median(launch - floor for launch, floor in pairs):.2f} s")
     # The others, each in a process of its own (each starts its own master and rospy node).
     for script in ("bench_scale.py", "bench_ros_control.py", "bench_lidar.py", "bench_lidar3d.py", "bench_stereo.py",
                    "bench_cameras.py"):
-        status = subprocess.call([sys.executable, os.path.join(HERE, script)])
+        status = subprocess.call([sys.executable, os.path.join(HERE, script), *(["--short"] if args.short else [])])
         if status:
             sys.exit(status)
+    return raw
 
 
 if __name__ == "__main__":

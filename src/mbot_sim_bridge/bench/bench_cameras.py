@@ -25,6 +25,7 @@ WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
 
 from sensor_msgs.msg import Image  # noqa: E402 (after the path set-up)
+from results import report  # noqa: E402
 
 from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera  # noqa: E402
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive  # noqa: E402
@@ -151,32 +152,33 @@ def main():
     parser.add_argument("--frames", type=int, default=5, help="frames timed per camera size")
     parser.add_argument("--sim-seconds", type=float, default=2.0, help="sim time of each real-time-factor run")
     parser.add_argument("--runs", type=int, default=1, help="runs per camera real-time factor (median)")
+    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
     args = parser.parse_args()
+    if args.short:
+        args.frames, args.sim_seconds = 1, 0.1
     kinect_urdf, camera_urdf = course_urdf("mbot_with_kinect_gazebo"), course_urdf("mbot_with_camera_gazebo")
     mbot_urdf = course_urdf("mbot_gazebo")
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
         for width, height in SIZES:
             render, depth, cloud, used = frame_costs(kinect_urdf, width, height, args.frames)
-            print(f"camera frame {width}x{height} ({used} renderer): {render:.1f} ms render + rgb8, {depth:.1f} ms "
-                  f"depth image, {cloud:.1f} ms point cloud", flush=True)
+            report(f"camera frame {width}x{height}, {renderer} renderer", f"{render:.1f} ms render + rgb8, "
+                   f"{depth:.1f} ms depth image, {cloud:.1f} ms point cloud ({used} used)")
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
-        print(f"real-time factor, course camera robot (1280x720 at 30 Hz, image subscribed, {renderer}): "
-              f"{median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds):.2f}", flush=True)
-        print(f"real-time factor, course kinect robot (640x480 at 20 Hz, rgb image subscribed, {renderer}): "
-              f"{median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds):.2f}", flush=True)
+        report(f"course camera robot real-time factor (1280x720 at 30 Hz, image subscribed), {renderer} renderer",
+               f"{median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds):.2f}")
+        report(f"course kinect robot real-time factor (640x480 at 20 Hz, rgb image subscribed), {renderer} renderer",
+               f"{median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds):.2f}")
     os.environ.pop(RENDERER_ENV)
     # A run takes a fraction of a second: pairs measured in turn, so that a slower moment of the machine
     # falls on both sides of a ratio.
     pairs = [(imu_rtf(mbot_urdf, args.sim_seconds, False), imu_rtf(mbot_urdf, args.sim_seconds, True))
-             for _ in range(IMU_PAIRS)]
+             for _ in range(1 if args.short else IMU_PAIRS)]
     without, with_imu = (statistics.median(side) for side in zip(*pairs))
     ratio = statistics.median(with_run / without_run for without_run, with_run in pairs)
-    print(f"real-time factor, mbot without IMU: {without:.2f}; with TurtleBot3's libgazebo_ros_imu.so at updateRate 0 "
-          f"(1000 readings a sim second): {with_imu:.2f}; ratio {ratio:.2f} (target >= 0.9; medians of "
-          f"{IMU_PAIRS} pairs)", flush=True)
-
+    report("mbot real-time factor with TurtleBot3's libgazebo_ros_imu.so at updateRate 0 / without",
+           f"{with_imu:.2f} / {without:.2f}; ratio {ratio:.2f} (target >= 0.9; medians of {len(pairs)} pairs)")
 
 if __name__ == "__main__":
     main()

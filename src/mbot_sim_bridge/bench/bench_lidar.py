@@ -18,6 +18,7 @@ from pybullet_utils.bullet_client import BulletClient
 from mbot_sim_bridge.core.geometry import compose, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.sensors.lidar import LaserScanner, RaySensorConfig
 from mbot_sim_bridge.core.log import c_stdout_to
+from results import report
 
 
 # The tutorial's rplidar (lidar_gazebo.xacro).
@@ -63,7 +64,10 @@ def angles(config):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scans", type=int, default=500, help="timed scans (default 500)")
+    parser.add_argument("--short", action="store_true", help="a few scans: every figure, quickly")
     args = parser.parse_args()
+    if args.short:
+        args.scans = 30
 
     with open(os.devnull, "w") as devnull, c_stdout_to(devnull):  # PyBullet prints "argv[0]="
         client = BulletClient(connection_mode=pybullet.DIRECT)
@@ -93,13 +97,12 @@ def main():
     separate, together = ten_sensors_cast(client, poses, directions)
     client.disconnect()
     beams = RPLIDAR.range_count
-    print(f"lidar scan ({beams} beams) median: {np.median(seconds) * 1e3:.3f} ms")
-    print(f"lidar scan ({beams} beams) mean: {seconds.mean() * 1e3:.3f} ms")
-    print(f"lidar scan ({beams} beams) p95: {np.percentile(seconds, 95) * 1e3:.3f} ms")
-    print(f"rayTestBatch alone ({beams} rays) median: {np.median(ray_seconds) * 1e3:.3f} ms")
-    print(f"ten lidars' rays, one rayTestBatch per lidar, median: {separate * 1e3:.3f} ms")
-    print(f"ten lidars' rays in one rayTestBatch, median: {together * 1e3:.3f} ms")
-
+    report("lidar scan median", f"{np.median(seconds) * 1e3:.3f} ms ({beams} beams)")
+    report("lidar scan mean", f"{seconds.mean() * 1e3:.3f} ms")
+    report("lidar scan p95", f"{np.percentile(seconds, 95) * 1e3:.3f} ms")
+    report("rayTestBatch alone, median", f"{np.median(ray_seconds) * 1e3:.3f} ms ({beams} rays)")
+    report("ten lidars' rays, one rayTestBatch per lidar, median", f"{separate * 1e3:.3f} ms")
+    report("ten lidars' rays in one rayTestBatch, median", f"{together * 1e3:.3f} ms")
 
 def ten_sensors_cast(client, poses, directions):
     """Median seconds to cast ten sensors' rays (ten robots' lidars due at the same step), one call per sensor

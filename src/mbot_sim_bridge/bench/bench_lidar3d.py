@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
+from results import report
 from sensor_msgs.msg import PointCloud2
 
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
@@ -64,7 +65,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sweeps", type=int, default=50, help="sweeps timed")
     parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each real-time-factor run")
+    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
     args = parser.parse_args()
+    if args.short:
+        args.sweeps, args.sim_seconds = 2, 0.2
     # The rover's Gazebo-only wheel tags and its robot_description lookup warn on every spawn; the figures are
     # what this prints.
     logging.getLogger("rosout.mbot_sim_bridge").setLevel(logging.ERROR)
@@ -79,12 +83,11 @@ def main():
     finally:
         sim.close()
     rings, samples = lidar.config.vertical_range_count, lidar.config.range_count
-    print(f"3D lidar sweep ({rings} rings x {samples} samples, cloud built and serialized, {size} bytes) median: "
-          f"{statistics.median(seconds) * 1e3:.2f} ms")
+    report("3D lidar sweep, cloud built and serialized, median", f"{statistics.median(seconds) * 1e3:.2f} ms "
+           f"({rings} rings x {samples} samples, {size} bytes)")
     with_lidar, without = rtf(True, args.sim_seconds), rtf(False, args.sim_seconds)
-    print(f"rover real-time factor with the 10 Hz 3D lidar subscribed: {with_lidar:.2f}; without the lidar: "
-          f"{without:.2f}; ratio {with_lidar / without:.2f}")
-
+    report("rover real-time factor with the 10 Hz 3D lidar subscribed / without the lidar",
+           f"{with_lidar:.2f} / {without:.2f}; ratio {with_lidar / without:.2f}")
 
 if __name__ == "__main__":
     main()

@@ -17,6 +17,7 @@ import time
 import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from rosgraph_msgs.msg import Clock
+from results import report
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
@@ -97,7 +98,7 @@ def bridge_rtf(command, ready_topics, wall_seconds: float, commands=None) -> flo
                                                                                 m.clock.to_sec())))]
         subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
                         for topic, _ in rospy.get_published_topics() if topic != "/clock"]
-        time.sleep(2.0)  # every subscription connects, and the robots reach their commanded turn
+        time.sleep(min(2.0, 4 * wall_seconds))  # every subscription connects, the robots reach their commanded turn
         window_start = len(clock)
         time.sleep(wall_seconds)
         (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
@@ -116,10 +117,13 @@ def main():
                         help="sim time of each raw run of up to ten robots (fewer for more robots)")
     parser.add_argument("--box-sim-seconds", type=float, default=0.5, help="sim time of the raw box-world run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each bridge run is measured")
+    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
     args = parser.parse_args()
+    if args.short:
+        args.sim_seconds, args.box_sim_seconds, args.wall_seconds = 0.2, 0.05, 0.3
 
-    def report(what, raw, bridge):
-        print(f"{what}: raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}", flush=True)
+    def report_ratio(what, raw, bridge):
+        report(what, f"raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}")
 
     # The raw runs go first: once rospy is up, the plugins' rosDebugLevel Debug would print every tag read.
     raw_robots = {count: raw_robots_rtf(count, args.sim_seconds * min(1.0, 10 / count)) for count in ROBOT_COUNTS}
@@ -139,11 +143,11 @@ def main():
                 bridge = bridge_rtf(["roslaunch", "mbot_gazebo", "multi_mbot.launch", f"count:={count}",
                                      "gui:=false", "real_time_factor:=0"],
                                     [f"/mbot_{n}/odom" for n in range(1, count + 1)], args.wall_seconds, commands)
-                report(f"scaling, {count} lidar mbot{'s' if count > 1 else ''}, real-time factor", raw_robots[count],
-                       bridge)
+                report_ratio(f"scaling, {count} lidar mbot{'s' if count > 1 else ''}, real-time factor",
+                             raw_robots[count], bridge)
             bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
                                  "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
-            report(f"{BOXES} static boxes, real-time factor", raw_boxes, bridge)
+            report_ratio(f"{BOXES} static boxes, real-time factor", raw_boxes, bridge)
 
 
 if __name__ == "__main__":

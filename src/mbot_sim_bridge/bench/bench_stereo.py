@@ -14,6 +14,7 @@ import statistics
 import time
 
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
+from results import report
 from sensor_msgs.msg import Image
 
 from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
@@ -55,7 +56,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=30, help="pair frames timed")
     parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each real-time-factor run")
+    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
     args = parser.parse_args()
+    if args.short:
+        args.frames, args.sim_seconds = 2, 0.2
     sim, stereo = spawn()
     try:
         sim.step(200)
@@ -67,12 +71,11 @@ def main():
     finally:
         sim.close()
     config = stereo.cameras["left"].config
-    print(f"stereo pair frame ({config.width}x{config.height} x 2, rendered and serialized, {size} bytes) median: "
-          f"{statistics.median(seconds) * 1e3:.2f} ms")
+    report("stereo pair frame, rendered and serialized, median", f"{statistics.median(seconds) * 1e3:.2f} ms "
+           f"({config.width}x{config.height} x 2, {size} bytes)")
     subscribed, idle = rtf(True, args.sim_seconds), rtf(False, args.sim_seconds)
-    print(f"stereo head real-time factor with both {stereo.frame_rate:g} Hz images subscribed: {subscribed:.2f}; "
-          f"with none: {idle:.2f}; ratio {subscribed / idle:.2f}")
-
+    report("stereo head real-time factor with both images subscribed / with none",
+           f"{subscribed:.2f} / {idle:.2f} ({stereo.frame_rate:g} Hz); ratio {subscribed / idle:.2f}")
 
 if __name__ == "__main__":
     main()

@@ -24,8 +24,15 @@ class SpawnError(Exception):
     pass
 
 
+class OneLineArgumentParser(argparse.ArgumentParser):
+    """A bad command line is said in one line (argparse prints its whole usage first), with argparse's status 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: {message} (spawn_model -h lists the options)\n")
+
+
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(prog="spawn_model", description="Spawn a model in the simulator "
+    parser = OneLineArgumentParser(prog="spawn_model", description="Spawn a model in the simulator "
                                      "(gazebo_ros's spawn_model command line).")
     kind = parser.add_mutually_exclusive_group(required=True)
     kind.add_argument("-urdf", action="store_true", help="the model is URDF")

@@ -98,6 +98,19 @@ def test_unknown_gazebo_tags_warn_once_and_name_the_tag(caplog):
     assert "<gazebo reference='nowhere'> names no link or joint" in text
 
 
+def test_joint_blocks_warn_once_per_tag_except_provide_feedback(caplog):
+    block = ('<gazebo reference="mount"><provideFeedback>true</provideFeedback><preserveFixedJoint>true'
+             '</preserveFixedJoint><implicitSpringDamper>1</implicitSpringDamper><sparkle/></gazebo>')
+    urdf = robot(link("chassis"), link("top"), joint("mount", "fixed", "chassis", "top"), block, block)
+    with caplog.at_level(logging.WARNING):
+        parse_robot(urdf, "model 'probe'")
+        parse_robot(urdf, "model 'probe'")
+    assert [r.getMessage() for r in caplog.records] == [
+        "model 'probe': <gazebo reference='mount'> (a joint) <preserveFixedJoint> has no Bullet counterpart; ignored",
+        "model 'probe': <gazebo reference='mount'> (a joint) <implicitSpringDamper> has no Bullet counterpart; ignored",
+        "model 'probe': <gazebo reference='mount'> (a joint) <sparkle> is not supported on a joint; ignored"]
+
+
 @pytest.mark.parametrize("xml, message", [
     ("", "robot_description is empty"),
     ("<robot name='a'><link name='x'>", "robot_description:1: not valid XML"),

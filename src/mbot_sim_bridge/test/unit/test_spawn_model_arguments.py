@@ -17,5 +17,13 @@ def test_a_position_that_is_not_a_number_is_refused_in_one_line(capsys):
     with pytest.raises(SystemExit) as exit_code:
         parse_arguments(BASE + ["-J", "elbow_joint", "up"])
     assert exit_code.value.code == 2
-    message = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    message = capsys.readouterr().err.splitlines()
     assert len(message) == 1 and "-J takes a joint name and a position" in message[0] and "'up'" in message[0]
+
+
+def test_a_bad_command_line_is_one_line_without_the_usage(capsys):
+    with pytest.raises(SystemExit) as exit_code:
+        parse_arguments(BASE + ["-J", "elbow_joint"])
+    assert exit_code.value.code == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "spawn_model: argument -J: expected 2 arguments (spawn_model -h lists the options)"]

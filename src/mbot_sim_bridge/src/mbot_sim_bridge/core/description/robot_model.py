@@ -40,6 +40,14 @@ LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "laserRetro", "maxConta
                        "maxVelocity", "provideFeedback", "implicitSpringDamper", "cfmDamping", "stopCfm",
                        "stopErp", "springStiffness", "springReference", "fudgeFactor", "visual", "collision",
                        "preserveFixedJoint", "disableFixedJointLumping")
+# <gazebo reference="joint"> tags (sdformat's URDF import reads them onto the joint). provideFeedback asks Gazebo
+# to compute the joint's wrench, which the ft sensor plugin here computes without it: accepted, nothing to do.
+JOINT_TAGS_USED = ("provideFeedback",)
+# Tags that set ODE's joint solver, its springs or Gazebo's fixed-joint lumping: no Bullet counterpart here (every
+# fixed joint is lumped, as without preserveFixedJoint): one warning per tag and model.
+JOINT_TAGS_NO_EFFECT = ("implicitSpringDamper", "cfmDamping", "stopCfm", "stopErp", "stopKp", "stopKd",
+                        "springStiffness", "springReference", "fudgeFactor", "preserveFixedJoint",
+                        "disableFixedJointLumping")
 # A wheel's tread (m) and how much narrower in radius its sides are (a fraction): see _with_treads. The sides
 # stay off flat ground until the wheel leans by about 2 degrees.
 TREAD_WIDTH = 0.002
@@ -127,6 +135,9 @@ class RobotModel:
     separate_surfaces: Tuple[str, ...] = ()
     # Links that roll (see _wheels): link -> (the first cylinder's centre, the unit axle), in the link frame.
     wheels: Dict[str, Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = field(default_factory=dict)
+    # The URDF text parsed: a plugin that reads the same text from a parameter reuses this model (and its warnings
+    # are said once, not once per reading).
+    xml: str = ""
 
     @property
     def anchored(self) -> bool:
@@ -359,7 +370,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
     _read_collision_radii(root, links, document)
     wheels = _wheels(root, links, joints, document)
     return RobotModel(name, roots[0], links, joints, plugins, lumped_into, _with_treads(pybullet_urdf, wheels),
-                      transmissions, document, separate, wheels)
+                      transmissions, document, separate, wheels, urdf_xml)
 
 
 def _wheels(root: ElementTree.Element, links, joints, document: XmlDocument):
@@ -457,9 +468,23 @@ def _collect_gazebo_blocks(root, links, joints, source) -> List[ElementTree.Elem
             links[reference].gazebo.append(block)
             for child in block:
                 _check_link_tag(child, reference, source)
-        elif reference not in joints:
+        elif reference in joints:
+            for child in block:
+                _check_joint_tag(child, reference, source)
+        else:
             warn_once(_logger, f"{source}: <gazebo reference='{reference}'> names no link or joint; ignored")
     return plugins
+
+
+def _check_joint_tag(child: ElementTree.Element, reference: str, source: str):
+    """Say once per tag and model that a <gazebo reference="JOINT"> tag is left out, and why."""
+    where = f"{source}: <gazebo reference='{reference}'> (a joint) <{child.tag}>"
+    if child.tag in JOINT_TAGS_USED:
+        return
+    if child.tag in JOINT_TAGS_NO_EFFECT:
+        warn_once(_logger, f"{where} has no Bullet counterpart; ignored")
+    else:
+        warn_once(_logger, f"{where} is not supported on a joint; ignored")
 
 
 def _check_link_tag(child: ElementTree.Element, reference: str, source: str):

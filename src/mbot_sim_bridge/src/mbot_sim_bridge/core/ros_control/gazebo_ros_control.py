@@ -135,7 +135,10 @@ class GazeboRosControlPlugin(Plugin):
                             "(gazebo_ros_control would wait for it); using the description the model was spawned "
                             "from")
             return self.context.robot.model
-        return parse_robot(self.context.simulation.package_uris(parameters.get(name)), f"parameter {name}")
+        xml = self.context.simulation.package_uris(parameters.get(name))
+        if xml == self.context.robot.model.xml:  # spawned from this parameter, as spawn_model -param does
+            return self.context.robot.model
+        return parse_robot(xml, f"parameter {name}")
 
     # -- loop ------------------------------------------------------------------------------------------------
     def load_controller(self, name: str) -> bool:

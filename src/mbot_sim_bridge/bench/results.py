@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""The one home of the speed figures: ``./mbot bench`` records every figure it prints into ``results.json`` (with
+the date, the machine and its raw PyBullet real-time factor), and the speed table of the bridge's README is
+generated from that file (``python3 results.py`` rewrites it; a test fails when the two differ).
+
+Each bench script reports through ``report()``: it prints ``FIGURE: VALUE`` as before and, when the bench runs
+them (``MBOT_BENCH_RECORD`` names a file), appends the figure there, so that a figure reaches the README only
+through what the bench printed.
+"""
+import datetime
+import json
+import os
+import platform
+import sys
+from typing import Dict, List
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "results.json")
+README = os.path.join(HERE, "..", "README.md")
+RECORD_ENV = "MBOT_BENCH_RECORD"
+TABLE_START = "<!-- speed table: generated from src/mbot_sim_bridge/bench/results.json by bench/results.py -->"
+TABLE_END = "<!-- end of the speed table -->"
+SHORT_NOTE = ("figures of `./mbot bench --short` (every row, tiny durations, a loaded machine): they show the "
+              "rows, not the speed; a full `./mbot bench` on a quiet machine replaces them")
+
+
+def report(figure: str, value: str):
+    """Print one figure and record it for results.json when the bench runs this script."""
+    print(f"{figure}: {value}", flush=True)
+    path = os.environ.get(RECORD_ENV)
+    if path:
+        with open(path, "a") as record:
+            record.write(json.dumps({"figure": figure, "value": value}) + "\n")
+
+
+def recorded(path: str) -> List[Dict[str, str]]:
+    if not os.path.exists(path):
+        return []
+    with open(path) as record:
+        return [json.loads(line) for line in record if line.strip()]
+
+
+def cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as cpuinfo:
+            return next(line.split(":", 1)[1].strip() for line in cpuinfo if line.startswith("model name"))
+    except (OSError, StopIteration):
+        return platform.processor() or platform.machine()
+
+
+def write_results(path: str, rows: List[Dict[str, str]], raw_pybullet: float, short: bool):
+    results = {
+        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d"),
+        "machine": f"{cpu_model()}, {os.cpu_count()} cores",
+        "raw_pybullet_real_time_factor": round(raw_pybullet, 2),
+        "note": SHORT_NOTE if short else "figures of a full `./mbot bench`",
+        "rows": rows,
+    }
+    with open(path, "w") as stream:
+        json.dump(results, stream, indent=1, ensure_ascii=False)
+        stream.write("\n")
+
+
+def speed_table(results: dict) -> str:
+    """The README's block: where the figures come from, then one row per figure."""
+    lines = [TABLE_START, "",
+             f"Measured {results['date']} on {results['machine']} (raw PyBullet: "
+             f"{results['raw_pybullet_real_time_factor']:g}x real time); {results['note']}.", "",
+             "| Figure | Value |", "|--------|-------|"]
+    lines += [f"| {row['figure']} | {row['value'].replace('|', '/')} |" for row in results["rows"]]
+    return "\n".join(lines + ["", TABLE_END])
+
+
+def with_table(text: str, results: dict) -> str:
+    start, end = text.index(TABLE_START), text.index(TABLE_END) + len(TABLE_END)
+    return text[:start] + speed_table(results) + text[end:]
+
+
+def load(path: str = RESULTS) -> dict:
+    with open(path) as stream:
+        return json.load(stream)
+
+
+def main():
+    """Rewrite the README's speed table from results.json (``--check``: exit 1 if it differs)."""
+    with open(README) as stream:
+        text = stream.read()
+    generated = with_table(text, load())
+    if "--check" in sys.argv[1:]:
+        sys.exit(0 if generated == text else 1)
+    with open(README, "w") as stream:
+        stream.write(generated)
+
+
+if __name__ == "__main__":
+    main()
