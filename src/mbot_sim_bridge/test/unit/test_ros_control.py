@@ -527,3 +527,13 @@ def test_a_publish_rate_without_a_period_refuses_the_diff_drive_controller(mbot_
         sim.step(100)
     finally:
         sim.close()
+
+
+def test_the_robot_param_holding_the_spawned_urdf_is_not_parsed_again():
+    """spawn_model -param sends the parameter's URDF parsed and written again (no declaration, no comments);
+    gazebo_ros_control recognises it and reuses the spawned model, so its warnings are said once."""
+    from mbot_sim_bridge.core.ros_control.gazebo_ros_control import _same_description
+    parameter = '<?xml version="1.0"?>\n<!-- the course -->\n<robot name="r"><link name="a"/></robot>'
+    assert _same_description(parameter, '<robot name="r"><link name="a" /></robot>')
+    assert not _same_description(parameter, '<robot name="r"><link name="b" /></robot>')
+    assert not _same_description("<robot", '<robot name="r" />')

@@ -15,6 +15,7 @@ the loop stops only where a controller publishes from its state at a stop (``Con
 """
 import sys
 from typing import Dict, List, Set
+from xml.etree import ElementTree
 
 from .. import names
 from ..log import get_logger, warn_once
@@ -48,6 +49,17 @@ GAZEBO_ROS_CONTROL_PARAMS = (
     Param("eStopTopic", str, "", "std_msgs/Bool topic: true stops every joint, false restarts the controllers",
           warn_if_missing=False),
 )
+
+
+def _same_description(parameter_xml: str, spawned_xml: str) -> bool:
+    """Whether the model was spawned from this parameter's text, as spawn_model -param sends it (parsed and
+    written again, without the XML declaration and comments): its model is then reused, not parsed again."""
+    if parameter_xml == spawned_xml:
+        return True
+    try:
+        return ElementTree.tostring(ElementTree.fromstring(parameter_xml), encoding="unicode") == spawned_xml
+    except ElementTree.ParseError:
+        return False  # parse_robot names the fault
 
 
 class _PublishSchedule:
@@ -136,7 +148,7 @@ class GazeboRosControlPlugin(Plugin):
                             "from")
             return self.context.robot.model
         xml = self.context.simulation.package_uris(parameters.get(name))
-        if xml == self.context.robot.model.xml:  # spawned from this parameter, as spawn_model -param does
+        if _same_description(xml, self.context.robot.model.xml):
             return self.context.robot.model
         return parse_robot(xml, f"parameter {name}")
 
