@@ -3,12 +3,14 @@
 (see the workspace's conftest.py), spread over pytest-xdist workers.
 
 Arguments go to pytest after the defaults, so ``-k PATTERN``, ``-n 1``, ``--durations=20`` or test paths narrow
-or change the run. Prints the measurements the tests recorded (``figure`` properties) and one closing line,
-``summary: N passed, N failed`` counting rostest's test cases one by one; exits non-zero on any failure.
+or change the run; without test paths, pytest.ini's testpaths are run. Prints the measurements the tests recorded
+(``figure`` properties), the run's wall time and one closing line, ``summary: N passed, N failed`` counting
+rostest's test cases one by one; exits non-zero on any failure.
 """
 import os
 import subprocess
 import sys
+import time
 import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -51,7 +53,11 @@ def main(arguments):
     command = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--rootdir", ROOT,
                "--junitxml", REPORT, "-n", str(WORKERS), "--dist", "loadgroup", "--durations", "10",
                *arguments]  # without test paths, pytest.ini's testpaths
+    started = time.monotonic()
     code = subprocess.call(command, cwd=ROOT)
+    minutes, seconds = divmod(round(time.monotonic() - started), 60)
+    # The suite's size and time are said here, where every run measures them, and nowhere else.
+    print(f"wall time: {minutes}:{seconds:02d}")
     if code == 5:  # nothing selected by the filter
         print("summary: 0 passed, 0 failed")
         return 0

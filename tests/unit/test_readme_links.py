@@ -1,4 +1,4 @@
-"""Every relative link in the workspace's READMEs reaches a file, and every #anchor a heading of it."""
+"""Every relative link in the workspace's READMEs and docs/ pages reaches a file, and every #anchor a heading of it."""
 import os
 import re
 
@@ -10,6 +10,8 @@ SKIPPED = (".venv", ".git", "build", "devel", "out")
 READMES = sorted(os.path.relpath(os.path.join(folder, "README.md"), WORKSPACE)
                  for folder, subfolders, names in os.walk(WORKSPACE)
                  if os.path.relpath(folder, WORKSPACE).split(os.sep)[0] not in SKIPPED and "README.md" in names)
+READMES += sorted(os.path.join("docs", name) for name in os.listdir(os.path.join(WORKSPACE, "docs"))
+                  if name.endswith(".md"))
 
 
 def anchors(path):

@@ -23,7 +23,8 @@ import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from results import README, RECORD_ENV, RESULTS, load, recorded, report, with_table, write_results
+from results import (README, RECORD_ENV, RESULTS, load, recorded, report, wait_for_clock, with_table,
+                     write_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
@@ -118,6 +119,7 @@ def bridge_rtf(wall_seconds: float):
         time.sleep(1.0)  # let every subscription connect before the measured window
         window_start, cpu_start = len(clock), cpu_seconds_by_kind()
         time.sleep(wall_seconds)
+        wait_for_clock(clock, window_start + 2)  # a short window on a loaded machine may hold none yet
         cpu_end = cpu_seconds_by_kind()
         (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
         for subscriber in subscribers:

@@ -17,7 +17,7 @@ import time
 import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from rosgraph_msgs.msg import Clock
-from results import report
+from results import report, wait_for_clock
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
@@ -101,6 +101,7 @@ def bridge_rtf(command, ready_topics, wall_seconds: float, commands=None) -> flo
         time.sleep(min(2.0, 4 * wall_seconds))  # every subscription connects, the robots reach their commanded turn
         window_start = len(clock)
         time.sleep(wall_seconds)
+        wait_for_clock(clock, window_start + 2)  # a short window of a slow world may hold none yet
         (wall0, sim0), (wall1, sim1) = clock[window_start], clock[-1]
         for item in subscribers + publishers:
             item.unregister()

@@ -12,6 +12,7 @@ import json
 import os
 import platform
 import sys
+import time
 from typing import Dict, List
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -31,6 +32,16 @@ def report(figure: str, value: str):
     if path:
         with open(path, "a") as record:
             record.write(json.dumps({"figure": figure, "value": value}) + "\n")
+
+
+def wait_for_clock(clock: list, count: int, timeout: float = 60.0):
+    """Until ``clock`` (the /clock messages a subscriber appends) holds ``count`` of them: a real-time factor
+    needs two inside its window."""
+    deadline = time.monotonic() + timeout
+    while len(clock) < count:
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"no /clock within {timeout:g} s")
+        time.sleep(0.05)
 
 
 def recorded(path: str) -> List[Dict[str, str]]:

@@ -1,4 +1,5 @@
-"""The package README's tag tables are the ones generated from the tables the plugins read."""
+"""The plugin reference's tag tables (docs/plugins.md) are the ones generated from the tables the plugins read,
+and the package README's supported-plugin table names every plugin."""
 import os
 
 import pytest
@@ -6,14 +7,17 @@ import pytest
 from mbot_sim_bridge.core.params import params_table_markdown
 from mbot_sim_bridge.plugins.registry import REGISTRY
 
-README = os.path.join(os.path.dirname(__file__), "..", "..", "README.md")
+PACKAGE = os.path.join(os.path.dirname(__file__), "..", "..")
+README = os.path.join(PACKAGE, "README.md")
+REFERENCE = os.path.join(PACKAGE, "..", "..", "docs", "plugins.md")
 
 
 @pytest.mark.parametrize("filename", sorted(REGISTRY))
-def test_readme_lists_every_tag_of_every_plugin_with_its_default_and_range(filename):
+def test_the_reference_lists_every_tag_of_every_plugin_with_its_default_and_range(filename):
     plugin_class = REGISTRY[filename]
-    text = open(README).read()
-    assert f"`{filename}`" in text, f"{filename} is not in the supported-plugin table"
-    assert params_table_markdown(plugin_class.PARAMS) in text
+    assert f"`{filename}`" in open(README).read(), f"{filename} is not in the README's supported-plugin table"
+    reference = open(REFERENCE).read()
+    assert f"`{filename}`" in reference, f"{filename} has no section in docs/plugins.md"
+    assert params_table_markdown(plugin_class.PARAMS) in reference
     if plugin_class.SENSOR_PARAMS:
-        assert params_table_markdown(plugin_class.SENSOR_PARAMS) in text
+        assert params_table_markdown(plugin_class.SENSOR_PARAMS) in reference
