@@ -1,7 +1,6 @@
-#!/usr/bin/env python3
 """The one home of the speed figures: ``./mbot bench`` records every figure it prints into ``results.json`` (with
 the date, the machine and its raw PyBullet real-time factor), and the speed table of the bridge's README is
-generated from that file (``python3 results.py`` rewrites it; a test fails when the two differ).
+generated from that file (by the bench, or ``python3 docs/generate_docs.py``; a test fails when the two differ).
 
 Each bench script reports through ``report()``: it prints ``FIGURE: VALUE`` as before and, when the bench runs
 them (``MBOT_BENCH_RECORD`` names a file), appends the figure there, so that a figure reaches the README only
@@ -11,7 +10,6 @@ import datetime
 import json
 import os
 import platform
-import sys
 import time
 from typing import Dict, List
 
@@ -19,7 +17,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results.json")
 README = os.path.join(HERE, "..", "README.md")
 RECORD_ENV = "MBOT_BENCH_RECORD"
-TABLE_START = "<!-- speed table: generated from src/mbot_sim_bridge/bench/results.json by bench/results.py -->"
+TABLE_START = "<!-- speed table: generated from src/mbot_sim_bridge/bench/results.json by docs/generate_docs.py -->"
 TABLE_END = "<!-- end of the speed table -->"
 SHORT_NOTE = ("figures of `./mbot bench --short` (every row, tiny durations, a loaded machine): they show the "
               "rows, not the speed; a full `./mbot bench` on a quiet machine replaces them")
@@ -90,18 +88,3 @@ def with_table(text: str, results: dict) -> str:
 def load(path: str = RESULTS) -> dict:
     with open(path) as stream:
         return json.load(stream)
-
-
-def main():
-    """Rewrite the README's speed table from results.json (``--check``: exit 1 if it differs)."""
-    with open(README) as stream:
-        text = stream.read()
-    generated = with_table(text, load())
-    if "--check" in sys.argv[1:]:
-        sys.exit(0 if generated == text else 1)
-    with open(README, "w") as stream:
-        stream.write(generated)
-
-
-if __name__ == "__main__":
-    main()

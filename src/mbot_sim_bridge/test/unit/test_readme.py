@@ -17,7 +17,6 @@ def test_the_reference_lists_every_tag_of_every_plugin_with_its_default_and_rang
     plugin_class = REGISTRY[filename]
     assert f"`{filename}`" in open(README).read(), f"{filename} is not in the README's supported-plugin table"
     reference = open(REFERENCE).read()
-    assert f"`{filename}`" in reference, f"{filename} has no section in docs/plugins.md"
     assert params_table_markdown(plugin_class.PARAMS) in reference
     if plugin_class.SENSOR_PARAMS:
         assert params_table_markdown(plugin_class.SENSOR_PARAMS) in reference
