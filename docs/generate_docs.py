@@ -58,10 +58,10 @@ def block() -> str:
         START,
         f"- **Plugins emulated** (`core/plugin_table.py`): {code_list(CORE_PLUGINS)}. Any other plugin or sensor "
         "warns once, naming it, and the rest of the robot works.",
-        "- **`<gazebo reference=\"LINK\">` tags ignored**, one warning per tag and model (no Bullet counterpart): "
+        "- **`<gazebo reference=\"LINK\">` tags ignored**, one warning per tag and link (no Bullet counterpart): "
         f"{code_list(robot_model.LINK_TAGS_NO_EFFECT)}; simulated only at Gazebo's default, another value warned: "
         f"{defaults}.",
-        "- **`<gazebo reference=\"JOINT\">` tags ignored**, one warning per tag and model: "
+        "- **`<gazebo reference=\"JOINT\">` tags ignored**, one warning per tag and joint: "
         f"{code_list(robot_model.JOINT_TAGS_NO_EFFECT)} (every fixed joint is lumped); accepted: "
         f"{code_list(robot_model.JOINT_TAGS_USED)} (the ft sensor computes a joint's wrench without it).",
         f"- **gazebo_ros services not served**: {code_list(missing_services) or 'none'}; **topics not served**: "

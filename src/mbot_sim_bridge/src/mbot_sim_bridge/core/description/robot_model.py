@@ -44,7 +44,7 @@ LINK_TAGS_NO_EFFECT = ("kp", "kd", "minDepth", "maxVel", "laserRetro", "maxConta
 # to compute the joint's wrench, which the ft sensor plugin here computes without it: accepted, nothing to do.
 JOINT_TAGS_USED = ("provideFeedback",)
 # Tags that set ODE's joint solver, its springs or Gazebo's fixed-joint lumping: no Bullet counterpart here (every
-# fixed joint is lumped, as without preserveFixedJoint): one warning per tag and model.
+# fixed joint is lumped, as without preserveFixedJoint): one warning per tag and joint.
 JOINT_TAGS_NO_EFFECT = ("implicitSpringDamper", "cfmDamping", "stopCfm", "stopErp", "stopKp", "stopKd",
                         "springStiffness", "springReference", "fudgeFactor", "preserveFixedJoint",
                         "disableFixedJointLumping")
