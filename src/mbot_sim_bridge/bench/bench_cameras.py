@@ -163,7 +163,7 @@ def main():
         for width, height in SIZES:
             render, depth, cloud, used = frame_costs(kinect_urdf, width, height, args.frames)
             report(f"camera frame {width}x{height}, {renderer} renderer", f"{render:.1f} ms render + rgb8, "
-                   f"{depth:.1f} ms depth image, {cloud:.1f} ms point cloud ({used} used)")
+                   f"{depth:.1f} ms depth image, {cloud:.1f} ms point cloud (rendered with {used})")
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
         report(f"course camera robot real-time factor (1280x720 at 30 Hz, image subscribed), {renderer} renderer",
