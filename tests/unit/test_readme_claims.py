@@ -5,8 +5,9 @@ In every README and docs page, inside code (fenced blocks and `inline` spans):
   `name:=value` after it an argument that world's launch file declares (./mbot sim refuses any other);
 - each `roslaunch PACKAGE FILE name:=value` names a launch file of the workspace that declares those arguments, and
   each `rosrun PACKAGE EXECUTABLE` of a workspace package an executable file of it;
-- each `/gazebo/NAME` is a service or topic the bridge's code serves, and each `~name` of the bridge's parameter
-  table a parameter its node reads;
+- each `/gazebo/NAME` is a service or topic the bridge's code serves, each `~name` of the bridge's parameter
+  table a parameter its node reads, and each part of a `rostopic pub|echo|hz` topic a word of the workspace's
+  launch, description, YAML or Python files (a weaker check: the topics come from tags and YAML);
 - each workspace path (`src/...`, `tests/...`, `worlds/...`, `docs/...`, `$(find PACKAGE)/...`) and each
   `NAME.world` exists;
 and `./mbot --help` lists every command the script dispatches.
@@ -173,6 +174,26 @@ def bridge_names():
     return names
 
 
+@functools.lru_cache(maxsize=None)
+def workspace_names():
+    """Every word of the workspace's launch, xacro, URDF, YAML, world and Python files: where a topic's parts
+    (a controller's name, a plugin's topic tag, a node's topic) are written."""
+    words = set()
+    for folder, subfolders, files in os.walk(os.path.join(WORKSPACE, "src")):
+        subfolders[:] = [name for name in subfolders if name not in ("__pycache__", "mbot_tests")]
+        for name in files:
+            if name.endswith((".launch", ".xacro", ".urdf", ".yaml", ".world", ".py", ".sdf")):
+                words.update(re.findall(r"\w+", open(os.path.join(folder, name), errors="replace").read()))
+    return words
+
+
+def topic_problems(span):
+    """`rostopic pub|echo|hz TOPIC`: every part of TOPIC is a word of the workspace's files."""
+    topics = re.findall(r"rostopic (?:pub|echo|hz)(?: -[a-z1-9]+| [0-9.]+)* (/[\w/]+)", span)
+    return [f"rostopic {topic}: '{part}' is named nowhere in the workspace" for topic in topics
+            for part in topic.strip("/").split("/") if part not in workspace_names()]
+
+
 def gazebo_problems(span):
     names = re.findall(r"(?<![\w.-])/gazebo/(\w+)\b(?!\.)", span)  # not urdf/gazebo/x.xacro
     return [f"/gazebo/{name}: nothing in the bridge serves it" for name in names
@@ -187,6 +208,7 @@ def test_every_command_path_and_name_in_the_document_exists(document):
     problems = []
     for line in code_of(text):
         problems += problems_of(line, worlds, commands) + path_problems(line, folder) + gazebo_problems(line)
+        problems += topic_problems(line)
         # my_world.world and one-letter names (a.world) are examples of the user's own
         problems += [f"{name}: no such world file" for name in re.findall(r"\b(\w\w+)\.world\b", line)
                      if name + ".world" not in world_files() and not is_placeholder(name)
@@ -227,3 +249,5 @@ def test_the_checks_catch_a_broken_line():
         "src/mbot_gazebo/launch/no_such.launch: no such file or folder"]
     assert gazebo_problems("rosservice call /gazebo/teleport_model") == [
         "/gazebo/teleport_model: nothing in the bridge serves it"]
+    assert topic_problems("rostopic pub -r 10 /mobile_base_controler/cmd_vel geometry_msgs/Twist") == [
+        "rostopic /mobile_base_controler/cmd_vel: 'mobile_base_controler' is named nowhere in the workspace"]
