@@ -6,7 +6,7 @@
 topic subscribed; the real-time factor of each and their ratio, the CPU seconds per sim second of every process
 (the bridge, its writer, rosmaster, robot_state_publisher, this subscribing client) and the ratio they leave room
 for, and the wall time from roslaunch to the first /odom (median of several launches);
-then ten robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
+then 1, 10 and 50 robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
 (bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
 Every figure goes to results.json, from which the README's speed table is generated (results.py).
 """
