@@ -43,7 +43,7 @@ def code_of(text):
     """The text of every fenced block, line by line, and of every inline code span (comments after # dropped)."""
     blocks = re.findall(r"(?ms)^```[a-z]*\n(.*?)^```", text)
     prose = re.sub(r"(?ms)^```[a-z]*\n.*?^```", "", text)
-    lines = [re.sub(r"\s#.*$", "", line) for block in blocks for line in block.splitlines()]
+    lines = [re.sub(r"(^|\s)#.*$", "", line) for block in blocks for line in block.splitlines()]
     return lines + [span.replace("\\|", "|") for span in re.findall(r"`([^`\n]+)`", prose)]
 
 
