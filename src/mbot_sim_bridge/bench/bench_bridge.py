@@ -9,6 +9,8 @@ for, and the wall time from roslaunch to the first /odom (median of several laun
 then 1, 10 and 50 robots and a 5,000-box world (bench_scale.py), ros_control beside the diff-drive plugin
 (bench_ros_control.py), the cost of one lidar scan (bench_lidar.py), and the cameras' and IMU's (bench_cameras.py).
 Every figure goes to results.json, from which the README's speed table is generated (results.py).
+``--short`` runs every row at smoke-test sizes and durations (1, 2 and 3 robots, 300 boxes, quarter-size camera
+images; one launch timed on the real-time factor's own launch) and writes no file unless ``--results`` says where.
 """
 import argparse
 import os
@@ -23,16 +25,16 @@ import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from results import (README, RECORD_ENV, RESULTS, load, recorded, report, wait_for_clock, with_table,
-                     write_results)
+from results import (README, RECORD_ENV, RESULTS, load, parse_arguments, recorded, report, wait_for_clock,
+                     with_table, write_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 STEP = 0.001
 WHEELS = ("left_wheel_joint", "right_wheel_joint")
 # --short: every figure measured over this little time (each script has its own short settings).
-SHORT_SIM_SECONDS = 0.5
-SHORT_WALL_SECONDS = 0.5
+SHORT_SIM_SECONDS = 0.2
+SHORT_WALL_SECONDS = 0.1
 
 
 def raw_pybullet_rtf(sim_seconds: float) -> float:
@@ -105,18 +107,20 @@ def cpu_seconds_by_kind() -> Dict[str, float]:
 
 
 def bridge_rtf(wall_seconds: float):
-    """(real-time factor, topics subscribed, CPU seconds per sim second by process kind, cores busy) of one
-    launch with every topic subscribed."""
+    """(real-time factor, topics subscribed, CPU seconds per sim second by process kind, cores busy, seconds from
+    roslaunch to the first /odom) of one launch with every topic subscribed."""
+    started = time.monotonic()
     launch = _launch()
     try:
         rospy.wait_for_message("/odom", Odometry, timeout=120)
+        first_odom = time.monotonic() - started
         clock = []
         subscribers = [rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(),
                                                                                 m.clock.to_sec())))]
         # rospy shares one connection per topic, so /clock is left out of the untyped subscriptions.
         subscribers += [rospy.Subscriber(topic, rospy.AnyMsg, lambda message: None)
                         for topic, _ in rospy.get_published_topics() if topic != "/clock"]
-        time.sleep(1.0)  # let every subscription connect before the measured window
+        time.sleep(min(1.0, 4 * wall_seconds))  # let every subscription connect before the measured window
         window_start, cpu_start = len(clock), cpu_seconds_by_kind()
         time.sleep(wall_seconds)
         wait_for_clock(clock, window_start + 2)  # a short window on a loaded machine may hold none yet
@@ -126,7 +130,8 @@ def bridge_rtf(wall_seconds: float):
             subscriber.unregister()
         used = {kind: cpu_end[kind] - cpu_start.get(kind, 0.0) for kind in cpu_end}
         per_sim_second = {kind: seconds / (sim1 - sim0) for kind, seconds in used.items()}
-        return (sim1 - sim0) / (wall1 - wall0), len(subscribers), per_sim_second, sum(used.values()) / (wall1 - wall0)
+        cores_busy = sum(used.values()) / (wall1 - wall0)
+        return (sim1 - sim0) / (wall1 - wall0), len(subscribers), per_sim_second, cores_busy, first_odom
     finally:
         stop_process_group(launch)
 
@@ -136,14 +141,12 @@ def main():
     parser.add_argument("--sim-seconds", type=float, default=20.0, help="sim time of the raw PyBullet run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time the bridge is measured")
     parser.add_argument("--launches", type=int, default=7, help="launches timed to the first /odom")
-    parser.add_argument("--short", action="store_true",
-                        help="every figure with tiny durations (checks that each runs; the figures mean little)")
     parser.add_argument("--results", metavar="FILE",
                         help=f"where the figures are written (default {os.path.relpath(RESULTS, WORKSPACE)}, whose "
                              "README table is then regenerated; --short writes only here)")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "every row at smoke-test sizes and durations")
     if args.short:
-        args.sim_seconds, args.wall_seconds, args.launches = SHORT_SIM_SECONDS, SHORT_WALL_SECONDS, 1
+        args.sim_seconds, args.wall_seconds = SHORT_SIM_SECONDS, SHORT_WALL_SECONDS
     with tempfile.TemporaryDirectory(prefix="mbot_bench_logs_") as logs:
         # Every ROS process of the bench logs here, not into ~/.ros/log: roslaunch measures the size of its log
         # directory (du) at each start, which grows with every run there and would count in the launch times.
@@ -166,7 +169,7 @@ def run(args) -> float:
     with PrivateMaster() as master:
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy and the launches
         rospy.init_node("bench_bridge", disable_signals=True)
-        bridge, topics, cpu, cores_busy = bridge_rtf(args.wall_seconds)
+        bridge, topics, cpu, cores_busy, first_odom = bridge_rtf(args.wall_seconds)
         report("one mbot, bridge real-time factor", f"{bridge:.2f} ({topics} topics subscribed)")
         report("one mbot, bridge / raw", f"{bridge / raw:.2f}")
         report("one mbot, CPU seconds per sim second",
@@ -178,8 +181,11 @@ def run(args) -> float:
         report("one mbot, bridge / raw at most (the processes beside the bridge as measured, a bridge costing what "
                "raw PyBullet does)", f"{os.cpu_count() / (1 / raw + beside) / raw:.2f}")
         # One launch varies by a few tenths of a second (process start-up, scheduling): the median of several,
-        # each beside a launch of the floor, in turn.
-        pairs = [(first_odom_seconds(), first_odom_seconds(LAUNCH_FLOOR)) for _ in range(args.launches)]
+        # each beside a launch of the floor, in turn. A short run times the launch measured above.
+        if args.short:
+            pairs = [(first_odom, first_odom_seconds(LAUNCH_FLOOR))]
+        else:
+            pairs = [(first_odom_seconds(), first_odom_seconds(LAUNCH_FLOOR)) for _ in range(args.launches)]
         launches, floors = sorted(launch for launch, _ in pairs), sorted(floor for _, floor in pairs)
         report("roslaunch to the first /odom", f"median {statistics.median(launches):.2f} s ({len(launches)} "
                f"launches, {launches[0]:.2f} to {launches[-1]:.2f} s)")

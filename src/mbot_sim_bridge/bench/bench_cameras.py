@@ -9,7 +9,8 @@
 (c) the real-time factor of the mbot with TurtleBot3's IMU plugin at updateRate 0 (a reading for every 1 ms
     step, serialized as the bridge does) against the same robot without it: the medians of seven pairs.
 
-The machine's load changes these figures (--runs N takes the median of N runs for (b)).
+The machine's load changes these figures (--runs N takes the median of N runs for (b)). ``--short`` renders
+every image at a quarter of its width and height, over tiny durations.
 
     PYTHONPATH=src/mbot_sim_bridge/src .venv/bin/python src/mbot_sim_bridge/bench/bench_cameras.py
 """
@@ -25,7 +26,7 @@ WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
 sys.path.insert(0, os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src"))
 
 from sensor_msgs.msg import Image  # noqa: E402 (after the path set-up)
-from results import report  # noqa: E402
+from results import parse_arguments, report  # noqa: E402
 
 from mbot_sim_bridge.core.cameras.camera import Camera, DepthCamera  # noqa: E402
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive  # noqa: E402
@@ -40,6 +41,8 @@ from mbot_sim_bridge.robot_description import expand_xacro  # noqa: E402
 
 PLAY_GROUND = os.path.join(WORKSPACE, "src", "mbot_gazebo", "worlds", "playground.world")
 SIZES = ((320, 240), (640, 480), (1280, 720))
+KINECT_SIZE, CAMERA_SIZE = (640, 480), (1280, 720)  # the course's xacros'
+SHORT_SCALE = 4  # --short divides every image's width and height by this
 IMU_PAIRS = 7
 # TurtleBot3 burger's IMU plugin block (turtlebot3_burger.gazebo.xacro), on a board lumped into the base.
 IMU_BLOCK = """<link name="imu_link"/>
@@ -70,11 +73,18 @@ def serialized(message) -> int:
     return buffer.tell()
 
 
+def resized(urdf: str, size, new_size) -> str:
+    """The URDF with its camera's image of ``size`` (width, height) made ``new_size``."""
+    for tag, old, new in zip(("width", "height"), size, new_size):
+        if f"<{tag}>{old}</{tag}>" not in urdf:
+            raise ValueError(f"the camera's <{tag}> is not {old}: the course's xacro changed")
+        urdf = urdf.replace(f"<{tag}>{old}</{tag}>", f"<{tag}>{new}</{tag}>")
+    return urdf
+
+
 def frame_costs(kinect_urdf: str, width: int, height: int, frames: int):
     """Median ms of: one frame (render, rgb8), the depth image, the point cloud."""
-    urdf = kinect_urdf.replace("<width>640</width>", f"<width>{width}</width>").replace(
-        "<height>480</height>", f"<height>{height}</height>")
-    sim, spawned = spawn(urdf)
+    sim, spawned = spawn(resized(kinect_urdf, KINECT_SIZE, (width, height)))
     try:
         kinect = next(plugin for plugin in spawned.plugins if isinstance(plugin, DepthCamera))
         sim.step(100)
@@ -152,24 +162,31 @@ def main():
     parser.add_argument("--frames", type=int, default=5, help="frames timed per camera size")
     parser.add_argument("--sim-seconds", type=float, default=2.0, help="sim time of each real-time-factor run")
     parser.add_argument("--runs", type=int, default=1, help="runs per camera real-time factor (median)")
-    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "images at a quarter of their width and height, one frame, tiny durations")
     if args.short:
         args.frames, args.sim_seconds = 1, 0.1
-    kinect_urdf, camera_urdf = course_urdf("mbot_with_kinect_gazebo"), course_urdf("mbot_with_camera_gazebo")
-    mbot_urdf = course_urdf("mbot_gazebo")
+    scale = SHORT_SCALE if args.short else 1
+
+    def scaled(size):
+        return size[0] // scale, size[1] // scale
+
+    kinect_size, camera_size = scaled(KINECT_SIZE), scaled(CAMERA_SIZE)
+    kinect_urdf, mbot_urdf = course_urdf("mbot_with_kinect_gazebo"), course_urdf("mbot_gazebo")
+    camera_urdf = resized(course_urdf("mbot_with_camera_gazebo"), CAMERA_SIZE, camera_size)
+    kinect_rtf_urdf = resized(kinect_urdf, KINECT_SIZE, kinect_size)
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
-        for width, height in SIZES:
+        for width, height in map(scaled, SIZES):
             render, depth, cloud, used = frame_costs(kinect_urdf, width, height, args.frames)
             report(f"camera frame {width}x{height}, {renderer} renderer", f"{render:.1f} ms render + rgb8, "
                    f"{depth:.1f} ms depth image, {cloud:.1f} ms point cloud (rendered with {used})")
     for renderer in ("tiny", "egl"):
         os.environ[RENDERER_ENV] = renderer
-        report(f"course camera robot real-time factor (1280x720 at 30 Hz, image subscribed), {renderer} renderer",
-               f"{median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds):.2f}")
-        report(f"course kinect robot real-time factor (640x480 at 20 Hz, rgb image subscribed), {renderer} renderer",
-               f"{median_of(args.runs, camera_rtf, kinect_urdf, args.sim_seconds):.2f}")
+        report(f"course camera robot real-time factor ({camera_size[0]}x{camera_size[1]} at 30 Hz, image subscribed), "
+               f"{renderer} renderer", f"{median_of(args.runs, camera_rtf, camera_urdf, args.sim_seconds):.2f}")
+        report(f"course kinect robot real-time factor ({kinect_size[0]}x{kinect_size[1]} at 20 Hz, rgb image "
+               f"subscribed), {renderer} renderer",
+               f"{median_of(args.runs, camera_rtf, kinect_rtf_urdf, args.sim_seconds):.2f}")
     os.environ.pop(RENDERER_ENV)
     # A run takes a fraction of a second: pairs measured in turn, so that a slower moment of the machine
     # falls on both sides of a ratio.

@@ -18,7 +18,7 @@ from pybullet_utils.bullet_client import BulletClient
 from mbot_sim_bridge.core.geometry import compose, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.sensors.lidar import LaserScanner, RaySensorConfig
 from mbot_sim_bridge.core.log import c_stdout_to
-from results import report
+from results import parse_arguments, report
 
 
 # The tutorial's rplidar (lidar_gazebo.xacro).
@@ -64,10 +64,9 @@ def angles(config):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scans", type=int, default=500, help="timed scans (default 500)")
-    parser.add_argument("--short", action="store_true", help="a few scans: every figure, quickly")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "ten scans")
     if args.short:
-        args.scans = 30
+        args.scans = 10  # the ten-lidar figures need ten
 
     with open(os.devnull, "w") as devnull, c_stdout_to(devnull):  # PyBullet prints "argv[0]="
         client = BulletClient(connection_mode=pybullet.DIRECT)

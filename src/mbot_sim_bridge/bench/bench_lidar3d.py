@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
-from results import report
+from results import parse_arguments, report
 from sensor_msgs.msg import PointCloud2
 
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
@@ -65,10 +65,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sweeps", type=int, default=50, help="sweeps timed")
     parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each real-time-factor run")
-    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "one sweep, tiny durations")
     if args.short:
-        args.sweeps, args.sim_seconds = 2, 0.2
+        args.sweeps, args.sim_seconds = 1, 0.1
     # The rover's Gazebo-only wheel tags and its robot_description lookup warn on every spawn; the figures are
     # what this prints.
     logging.getLogger("rosout.mbot_sim_bridge").setLevel(logging.ERROR)

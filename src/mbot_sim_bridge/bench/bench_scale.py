@@ -7,6 +7,7 @@
 - a world of 5,000 static boxes: raw is the PyBullet world stepped alone; the bridge loads it at real-time
   factor 0 with every topic (model_states included) subscribed.
 Real-time factors are sim seconds per wall second; the bridge's is read from /clock over the window.
+``--short``: 1, 2 and 3 robots and 300 boxes, over tiny durations.
 """
 import argparse
 import os
@@ -17,12 +18,12 @@ import time
 import rospy
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from rosgraph_msgs.msg import Clock
-from results import report, wait_for_clock
+from results import parse_arguments, report, wait_for_clock
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 WORKSPACE = os.path.abspath(os.path.join(HERE, "..", "..", ".."))
-ROBOT_COUNTS = (1, 10, 50)
-BOXES = 5000
+ROBOT_COUNTS, SHORT_ROBOT_COUNTS = (1, 10, 50), (1, 2, 3)
+BOXES, SHORT_BOXES = 5000, 300
 
 
 def raw_robots_rtf(robots: int, sim_seconds: float) -> float:
@@ -52,11 +53,11 @@ def turn_rate(index: int) -> float:
     return 0.1 * (index + 1) * (-1) ** index
 
 
-def box_world(path: str):
-    """BOXES static 0.2 m boxes on a 0.5 m grid, and the ground."""
+def box_world(path: str, boxes: int):
+    """``boxes`` static 0.2 m boxes on a 0.5 m grid, and the ground."""
     rows = ["<sdf version='1.6'><world name='boxes'><include><uri>model://ground_plane</uri></include>"]
-    side = int(BOXES ** 0.5) + 1
-    for index in range(BOXES):
+    side = int(boxes ** 0.5) + 1
+    for index in range(boxes):
         x, y = 0.5 * (index % side), 0.5 * (index // side)
         rows.append(f"<model name='box_{index}'><static>true</static><pose>{x:g} {y:g} 0.1 0 0 0</pose>"
                     "<link name='l'><collision name='c'><geometry><box><size>0.2 0.2 0.2</size></box></geometry>"
@@ -118,24 +119,25 @@ def main():
                         help="sim time of each raw run of up to ten robots (fewer for more robots)")
     parser.add_argument("--box-sim-seconds", type=float, default=0.5, help="sim time of the raw box-world run")
     parser.add_argument("--wall-seconds", type=float, default=10.0, help="wall time each bridge run is measured")
-    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "1, 2 and 3 robots, 300 boxes, tiny durations")
+    robot_counts, boxes = ROBOT_COUNTS, BOXES
     if args.short:
-        args.sim_seconds, args.box_sim_seconds, args.wall_seconds = 0.2, 0.05, 0.3
+        robot_counts, boxes = SHORT_ROBOT_COUNTS, SHORT_BOXES
+        args.sim_seconds, args.box_sim_seconds, args.wall_seconds = 0.1, 0.05, 0.1
 
     def report_ratio(what, raw, bridge):
         report(what, f"raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}")
 
     # The raw runs go first: once rospy is up, the plugins' rosDebugLevel Debug would print every tag read.
-    raw_robots = {count: raw_robots_rtf(count, args.sim_seconds * min(1.0, 10 / count)) for count in ROBOT_COUNTS}
+    raw_robots = {count: raw_robots_rtf(count, args.sim_seconds * min(1.0, 10 / count)) for count in robot_counts}
     with tempfile.TemporaryDirectory() as directory:
         world = os.path.join(directory, "boxes.world")
-        box_world(world)
+        box_world(world, boxes)
         raw_boxes = raw_boxes_rtf(world, args.box_sim_seconds)
         with PrivateMaster() as master:
             os.environ["ROS_MASTER_URI"] = master.uri
             rospy.init_node("bench_scale", disable_signals=True)
-            for count in ROBOT_COUNTS:
+            for count in robot_counts:
                 commands = {}
                 for index in range(count):
                     twist = Twist()
@@ -148,7 +150,7 @@ def main():
                              raw_robots[count], bridge)
             bridge = bridge_rtf(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
                                  "real_time_factor:=0", "world_name:=" + world], ["/clock"], args.wall_seconds)
-            report_ratio(f"{BOXES} static boxes, real-time factor", raw_boxes, bridge)
+            report_ratio(f"{boxes} static boxes, real-time factor", raw_boxes, bridge)
 
 
 if __name__ == "__main__":

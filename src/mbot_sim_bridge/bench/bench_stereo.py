@@ -14,7 +14,7 @@ import statistics
 import time
 
 from bench_cameras import PLAY_GROUND, WORKSPACE, serialized, timed_rtf
-from results import report
+from results import parse_arguments, report
 from sensor_msgs.msg import Image
 
 from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
@@ -56,10 +56,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=30, help="pair frames timed")
     parser.add_argument("--sim-seconds", type=float, default=5.0, help="sim time of each real-time-factor run")
-    parser.add_argument("--short", action="store_true", help="tiny durations: every figure, quickly")
-    args = parser.parse_args()
+    args = parse_arguments(parser, "one frame, tiny durations")
     if args.short:
-        args.frames, args.sim_seconds = 2, 0.2
+        args.frames, args.sim_seconds = 1, 0.1
     sim, stereo = spawn()
     try:
         sim.step(200)

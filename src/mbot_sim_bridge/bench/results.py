@@ -4,8 +4,10 @@ generated from that file (by the bench, or ``python3 docs/generate_docs.py``; a 
 
 Each bench script reports through ``report()``: it prints ``FIGURE: VALUE`` as before and, when the bench runs
 them (``MBOT_BENCH_RECORD`` names a file), appends the figure there, so that a figure reaches the README only
-through what the bench printed.
+through what the bench printed. ``--short`` (every script's, through ``parse_arguments()``) runs every row at
+smoke-test sizes and durations, and each row's figure then starts with ``SHORT_MARK``.
 """
+import argparse
 import datetime
 import json
 import os
@@ -19,12 +21,25 @@ README = os.path.join(HERE, "..", "README.md")
 RECORD_ENV = "MBOT_BENCH_RECORD"
 TABLE_START = "<!-- speed table: generated from src/mbot_sim_bridge/bench/results.json by docs/generate_docs.py -->"
 TABLE_END = "<!-- end of the speed table -->"
-SHORT_NOTE = ("figures of `./mbot bench --short` (every row, tiny durations, a loaded machine): they show the "
-              "rows, not the speed; a full `./mbot bench` on a quiet machine replaces them")
+SHORT_MARK = "[short mode] "
+SHORT_NOTE = ("figures of `./mbot bench --short` (every row at smoke-test sizes and durations): they show that "
+              "the rows run, not the speed; a full `./mbot bench` on a quiet machine replaces them")
+_short = False
+
+
+def parse_arguments(parser: argparse.ArgumentParser, short_help: str) -> argparse.Namespace:
+    """The script's arguments with ``--short`` added; in short mode every figure reported is marked so."""
+    global _short
+    parser.add_argument("--short", action="store_true", help=short_help + " (a smoke test; the figures mean little)")
+    args = parser.parse_args()
+    _short = args.short
+    return args
 
 
 def report(figure: str, value: str):
     """Print one figure and record it for results.json when the bench runs this script."""
+    if _short:
+        figure = SHORT_MARK + figure
     print(f"{figure}: {value}", flush=True)
     path = os.environ.get(RECORD_ENV)
     if path:
