@@ -1,17 +1,10 @@
 """The READMEs' generated parts equal what their generators make from the code and the data: the speed table from
 src/mbot_sim_bridge/bench/results.json, the lists of "What differs from Gazebo" from the code's own lists. The
-short bench itself (every figure printed and recorded) runs with MBOT_FULL_SWEEP=1: it launches every bench setup,
-50 robots included, which takes minutes."""
+short bench itself runs in integration/test_bench.py."""
 import importlib.util
-import json
 import os
-import subprocess
-import sys
-
-import pytest
 
 WORKSPACE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BENCH = os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "bench")
 
 
 def load_module(path):
@@ -42,13 +35,3 @@ def test_what_differs_lists_are_the_ones_generated_from_the_code():
     text = open(generate_docs.README).read()
     assert generate_docs.with_block(text) == text, "run: python3 docs/generate_docs.py"
 
-
-@pytest.mark.skipif(not os.environ.get("MBOT_FULL_SWEEP"), reason="minutes: every bench setup (MBOT_FULL_SWEEP=1)")
-def test_the_short_bench_prints_and_records_every_figure_of_the_results_file(tmp_path):
-    written = tmp_path / "results.json"
-    run = subprocess.run([sys.executable, os.path.join(BENCH, "bench_bridge.py"), "--short", "--results",
-                          str(written)], capture_output=True, text=True, timeout=1200)
-    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
-    figures = [row["figure"] for row in json.loads(written.read_text())["rows"]]
-    assert figures == [row["figure"] for row in results.load()["rows"]]
-    assert all(f"{figure}: " in run.stdout for figure in figures)

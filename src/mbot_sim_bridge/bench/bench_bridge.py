@@ -34,7 +34,7 @@ STEP = 0.001
 WHEELS = ("left_wheel_joint", "right_wheel_joint")
 # --short: every figure measured over this little time (each script has its own short settings).
 SHORT_SIM_SECONDS = 0.2
-SHORT_WALL_SECONDS = 0.1
+SHORT_WALL_SECONDS = 0.05
 
 
 def raw_pybullet_rtf(sim_seconds: float) -> float:

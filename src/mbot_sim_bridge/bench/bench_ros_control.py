@@ -63,7 +63,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=3, help="rounds of the three runs, measured in turn")
     args = parse_arguments(parser, "one round, tiny durations")
     if args.short:
-        args.wall_seconds, args.rounds = 0.1, 1
+        args.wall_seconds, args.rounds = 0.05, 1
     with PrivateMaster() as master:
         os.environ["ROS_MASTER_URI"] = master.uri  # for this process's rospy
         rospy.init_node("bench_ros_control", disable_signals=True)

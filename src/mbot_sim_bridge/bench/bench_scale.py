@@ -123,7 +123,7 @@ def main():
     robot_counts, boxes = ROBOT_COUNTS, BOXES
     if args.short:
         robot_counts, boxes = SHORT_ROBOT_COUNTS, SHORT_BOXES
-        args.sim_seconds, args.box_sim_seconds, args.wall_seconds = 0.1, 0.05, 0.1
+        args.sim_seconds, args.box_sim_seconds, args.wall_seconds = 0.1, 0.05, 0.05
 
     def report_ratio(what, raw, bridge):
         report(what, f"raw PyBullet {raw:.2f}, bridge {bridge:.2f}, bridge / raw {bridge / raw:.2f}")
