@@ -16,6 +16,7 @@ from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, BodyReque
                              SpawnModelResponse)
 from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelProperties, GetModelPropertiesResponse,
                              SetModelConfiguration, SetModelConfigurationResponse)
+from gazebo_msgs.srv import ApplyJointEffort, ApplyJointEffortResponse, JointRequest, JointRequestResponse
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
@@ -94,6 +95,8 @@ class GazeboRosApi:
             rospy.Service("~set_model_configuration", SetModelConfiguration, self._set_model_configuration),
             rospy.Service("~get_model_properties", GetModelProperties, self._get_model_properties),
             rospy.Service("~get_link_state", GetLinkState, self._get_link_state),
+            rospy.Service("~apply_joint_effort", ApplyJointEffort, self._apply_joint_effort),
+            rospy.Service("~clear_joint_forces", JointRequest, self._clear_joint_forces),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -262,6 +265,17 @@ class GazeboRosApi:
         return self._guarded(GetPhysicsPropertiesResponse, get)
 
     # -- joints --------------------------------------------------------------------------------------------------
+    def _apply_joint_effort(self, request):
+        def apply():
+            self.sim.apply_joint_effort(request.joint_name, request.effort, request.start_time.to_sec(),
+                                        request.duration.to_sec())
+            return ApplyJointEffortResponse(success=True, status_message="ApplyJointEffort: effort set")
+        return self._guarded(ApplyJointEffortResponse, apply)
+
+    def _clear_joint_forces(self, request):
+        self.node.call_in_loop(lambda: self.sim.joint_efforts.clear_named(request.joint_name))
+        return JointRequestResponse()
+
     def _set_model_configuration(self, request):
         def set_configuration():
             missing = self.sim.set_model_configuration(request.model_name, request.joint_names,

@@ -20,6 +20,8 @@ from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
 from .engine import Engine, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
+from .joints import joint_efforts
+from .joints.joint_efforts import JointEfforts
 from .joints.model_configuration import requested_positions
 from .log import get_logger, warn_once
 from .parameters import Parameters
@@ -79,6 +81,7 @@ class Simulation:
         self._frozen: Set[str] = set()  # models the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
+        self.joint_efforts = JointEfforts()  # apply_joint_effort's
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -165,6 +168,7 @@ class Simulation:
             self._schedule()
         self.world_models.pop(name, None)
         self.wrenches.clear(name)
+        self.joint_efforts.clear(name)
         self.engine.remove(name)
         self.version += 1
 
@@ -179,6 +183,23 @@ class Simulation:
     def clear_body_wrenches(self, body: str):
         model, _, link = body.partition("::")
         self.wrenches.clear(model, link)
+
+    # -- efforts on joints from outside (apply_joint_effort) ---------------------------------------------------------
+    def apply_joint_effort(self, joint_name: str, effort: float, start_time: float, duration: float):
+        """Schedule an effort on a robot's joint ("joint" or "model::joint"), as gazebo_ros's apply_joint_effort
+        (see ``joints.joint_efforts``; ModelError with upstream's message)."""
+        movable = [(name, spawned.robot.movable_joints) for name, spawned in self.models.items()]
+        self.joint_efforts.add(joint_efforts.requested_job(joint_name, effort, start_time, duration, self.sim_time,
+                                                           movable, self._effort_limit))
+
+    def _effort_limit(self, model: str, joint: str) -> Optional[float]:
+        described = self.models[model].robot.model.joints[joint]
+        return described.effort if described.has_limit and described.effort > 0 else None
+
+    def _apply_joint_efforts(self):
+        for (model, joint), effort in self.joint_efforts.due(self.sim_time).items():
+            if model not in self._frozen:
+                self.models[model].robot.set_joint_effort(joint, effort)
 
     def link_names(self, model: str) -> List[str]:
         """The links a model has in the physics (a robot's after lumping, a world model's own)."""
@@ -331,9 +352,10 @@ class Simulation:
         steps of a batch, so they do not end it."""
         now, step = self.sim_time, self.step_size
         batch = max(1, int(round(MAX_BATCH_SIM_SECONDS / step)))
-        wrench_steps = self.wrenches.steps_until_next(now, step)
-        if wrench_steps is not None:
-            batch = min(batch, wrench_steps)
+        for jobs in (self.wrenches, self.joint_efforts):
+            job_steps = jobs.steps_until_next(now, step)
+            if job_steps is not None:
+                batch = min(batch, job_steps)
         # A timer is part of its plugin: one that raises (an overflowing period) disables the plugin, not the loop.
         return min([batch] + [self._guarded(plugin, plugin.timer.steps_until_due, now, step) or sys.maxsize
                               for plugin in self._plugins])
@@ -343,6 +365,8 @@ class Simulation:
         count = max(1, min(max_steps, self.steps_to_next_event()))
         if self.wrenches.pending() or self.wrenches.applied:
             self._apply_wrenches()
+        if self.joint_efforts.pending():
+            self._apply_joint_efforts()
         recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
         per_step = [recorder for recorder in recorders if recorder is not None]
         per_step += self._every_step_calls
@@ -436,7 +460,9 @@ class Simulation:
         else:
             self.engine.reset_world()
         self._frozen.clear()
-        self.wrenches = BodyWrenches()  # resets repair what service calls left: wrenches "until cleared" too
+        # Resets repair what service calls left: wrenches and efforts "until cleared" too.
+        self.wrenches = BodyWrenches()
+        self.joint_efforts = JointEfforts()
         self._schedule()
         self.version += 1
         for plugin in list(self._plugins):
