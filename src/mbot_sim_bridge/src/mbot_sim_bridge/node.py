@@ -174,6 +174,7 @@ class SimBridgeNode:
         if self._sets_rospy_time:
             rospy.rostime._set_rostime(stamp)
         self.api.model_states.publish()
+        self.api.link_states.publish()
         # The timer guarantees the longest gap between two /clock messages, counted from the last one.
         self.clock_timer.reset(now)
         self._last_clock = now

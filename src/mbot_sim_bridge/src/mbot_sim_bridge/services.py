@@ -17,6 +17,8 @@ from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, BodyReque
 from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelProperties, GetModelPropertiesResponse,
                              SetModelConfiguration, SetModelConfigurationResponse)
 from gazebo_msgs.srv import ApplyJointEffort, ApplyJointEffortResponse, JointRequest, JointRequestResponse
+from gazebo_msgs.srv import SetLinkState, SetLinkStateResponse
+from gazebo_msgs.msg import LinkState, ModelState
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
@@ -24,18 +26,19 @@ from std_srvs.srv import Empty, EmptyResponse
 
 from .core.engine import check_model_name, check_state
 from .core.errors import BridgeError, ModelError
-from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
+from .core.geometry import Pose, compose, rotate
 from .gazebo_paths import model_path
 from .core.description.robot_model import parse_robot
 from .core.description.sdf_spawn import spawn_world_xml
 from .core.description.sdf_world import parse_world
-from .model_states import ModelStatesPublisher
+from .model_states import LinkStatesPublisher, ModelStatesPublisher
 from .package_uris import resolve_package_uris
 from .plugins import ros_time
 from .subscriptions import drain
 from .world_saving import SaveWorldHandler
 
-_WORLD_FRAMES = ("", "world", "map", "/map")
+SPAWN_FRAME_NOT_FOUND = ("SpawnModel: reference reference_frame not found, did you forget to scope the link by model "
+                         "name?")
 # How long a step request waits for the bridge's subscribers to handle what reached them.
 LOCKSTEP_DRAIN_SECONDS = 5.0
 # One step_simulation call covers at most this much sim time: the largest uint32 count would hold the
@@ -65,6 +68,10 @@ def _pose_to_message(pose: Pose) -> PoseMessage:
     return message
 
 
+def _twist_vectors(twist: Twist):
+    return ((twist.linear.x, twist.linear.y, twist.linear.z), (twist.angular.x, twist.angular.y, twist.angular.z))
+
+
 def _twist_message(linear, angular) -> Twist:
     twist = Twist()
     twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
@@ -77,6 +84,14 @@ class GazeboRosApi:
         self.node = node
         self.sim = node.sim
         self.model_states = ModelStatesPublisher(self.sim)
+        self.link_states = LinkStatesPublisher(self.sim)
+        # As upstream's: the topics take the services' requests, and a refused one is only logged.
+        self._subscribers = [
+            rospy.Subscriber("~set_model_state", ModelState, lambda state: self._set_model_state(
+                SetModelState._request_class(model_state=state))),
+            rospy.Subscriber("~set_link_state", LinkState, lambda state: self._set_link_state(
+                SetLinkState._request_class(link_state=state))),
+        ]
         self._services = [
             rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
             rospy.Service("~spawn_sdf_model", SpawnModel, self._spawn_sdf_model),
@@ -97,6 +112,7 @@ class GazeboRosApi:
             rospy.Service("~get_link_state", GetLinkState, self._get_link_state),
             rospy.Service("~apply_joint_effort", ApplyJointEffort, self._apply_joint_effort),
             rospy.Service("~clear_joint_forces", JointRequest, self._clear_joint_forces),
+            rospy.Service("~set_link_state", SetLinkState, self._set_link_state),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -123,7 +139,7 @@ class GazeboRosApi:
         requested = _pose_from_message(request.initial_pose)
         # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
         check_state(f"SpawnModel: model '{request.model_name}'", requested)
-        pose = compose(self._reference_pose(request.reference_frame), requested)
+        pose = compose(self.sim.reference_pose(request.reference_frame, SPAWN_FRAME_NOT_FOUND), requested)
         check_state(f"SpawnModel: model '{request.model_name}'", pose)
         return pose
 
@@ -192,20 +208,9 @@ class GazeboRosApi:
         return self._guarded(StepSimulationResponse, step, timeout=None)
 
     # -- state queries ---------------------------------------------------------------------------------------
-    def _reference_pose(self, frame: str) -> Pose:
-        if frame in _WORLD_FRAMES:
-            return IDENTITY
-        if frame in self.sim.model_names():
-            return self.sim.engine.model_pose(frame)
-        raise ModelError(f"reference frame '{frame}' is neither the world nor a model")
-
     def _get_model_state(self, request):
         def get():
-            engine = self.sim.engine
-            reference = inverse(self._reference_pose(request.relative_entity_name))
-            pose = compose(reference, engine.model_pose(request.model_name))
-            linear, angular = engine.model_velocity(request.model_name)
-            linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
+            pose, linear, angular = self.sim.model_state(request.model_name, request.relative_entity_name)
             response = GetModelStateResponse(pose=_pose_to_message(pose), twist=_twist_message(linear, angular),
                                              success=True, status_message="GetModelState: got properties")
             response.header.stamp = ros_time(self.sim.sim_time)
@@ -217,10 +222,11 @@ class GazeboRosApi:
         state = request.model_state
 
         def set_state():
-            reference = self._reference_pose(state.reference_frame)
-            requested, twist = _pose_from_message(state.pose), state.twist
-            linear, angular = ((twist.linear.x, twist.linear.y, twist.linear.z),
-                               (twist.angular.x, twist.angular.y, twist.angular.z))
+            if state.model_name not in self.sim.model_names():
+                raise ModelError("SetModelState: model does not exist")
+            reference = self.sim.reference_pose(state.reference_frame,
+                                                 "SetModelState: specified reference frame entity does not exist")
+            requested, (linear, angular) = _pose_from_message(state.pose), _twist_vectors(state.twist)
             # Checked as sent too: transformed, 1e300 would turn inf and NaN, and on other axes.
             check_state(f"SetModelState: model '{state.model_name}'", requested, linear, angular)
             pose = compose(reference, requested)
@@ -228,6 +234,15 @@ class GazeboRosApi:
             self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
+
+    def _set_link_state(self, request):
+        state = request.link_state
+
+        def set_state():
+            self.sim.set_link_state(state.link_name, state.reference_frame, _pose_from_message(state.pose),
+                                    *_twist_vectors(state.twist))
+            return SetLinkStateResponse(success=True, status_message="SetLinkState: success")
+        return self._guarded(SetLinkStateResponse, set_state)
 
     # -- wrenches ----------------------------------------------------------------------------------------------
     def _apply_body_wrench(self, request):

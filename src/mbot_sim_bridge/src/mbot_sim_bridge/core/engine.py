@@ -475,6 +475,20 @@ class Engine:
         self.client.resetBaseVelocity(body, linear, angular)
         self._settle(body)
 
+    def move_model(self, name: str, pose: Pose, point, linear, angular, stop_joints: bool):
+        """Move a model's frame to ``pose``, as one rigid body turning at ``angular`` whose ``point`` (world, after
+        the move) has velocity ``linear``; ``stop_joints``: its joints' velocities become 0 (set_link_state)."""
+        body = self.body_of(name)
+        com = compose(pose, inverse(self._root_from_com[body]))
+        self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
+        com_linear = np.add(linear, np.cross(angular, np.subtract(com.position, point)))
+        self.client.resetBaseVelocity(body, com_linear.tolist(), list(angular))
+        if stop_joints:
+            for index, (position, *_) in enumerate(self.client.getJointStates(
+                    body, range(self.client.getNumJoints(body))) or ()):
+                self.client.resetJointState(body, index, position, 0.0)
+        self._settle(body)
+
     def set_joint_positions(self, robot: SpawnedRobot, positions: Dict[str, float]):
         """Joints of a robot put at positions, at rest (set_model_configuration)."""
         robot.set_joint_positions(positions)

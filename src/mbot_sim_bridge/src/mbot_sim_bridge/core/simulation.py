@@ -17,7 +17,7 @@ import pybullet
 
 from .added_plugins import joint_state_blocks, mimic_blocks
 from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
-from .engine import Engine, frame_velocity
+from .engine import Engine, check_state, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
 from .joints import joint_efforts
@@ -235,21 +235,81 @@ class Simulation:
 
     def link_state(self, link_name: str, reference_frame: str) -> Tuple[Pose, Vector, Vector]:
         """get_link_state: a "model::link"'s pose and (linear, angular) velocity relative to any entity, as
-        gazebo_ros computes them (the velocities are the differences with the frame's, rotated into it)."""
+        gazebo_ros computes them (``_relative``)."""
         model, _, link = link_name.partition("::")
         if not link or link not in self.link_names(model):
             raise ModelError("GetLinkState: link not found, did you forget to scope the link by model name?")
-        pose, (linear, angular) = self._link_pose(model, link), self._entity_twist(link_name)
-        frame = self._entity_pose(reference_frame)
+        return self._relative(reference_frame, self._link_pose(model, link), *self._entity_twist(link_name),
+                              "GetLinkState: reference reference_frame not found, did you forget to scope the link "
+                              "by model name?")
+
+    def model_state(self, name: str, relative_entity_name: str) -> Tuple[Pose, Vector, Vector]:
+        """get_model_state: a model's pose and (linear, angular) velocity relative to any entity (``_relative``)."""
+        if name not in self.model_names():
+            raise ModelError("GetModelState: model does not exist")
+        return self._relative(relative_entity_name, self.engine.model_pose(name), *self.engine.model_velocity(name),
+                              "GetModelState: reference relative_entity_name not found, did you forget to scope the "
+                              "body by model name?")
+
+    def _relative(self, frame_name: str, pose: Pose, linear, angular, not_found: str) -> Tuple[Pose, Vector, Vector]:
+        """A world state seen from entity ``frame_name`` as gazebo_ros's get_*_state compute it: the pose relative
+        to the frame, the velocities the differences with the frame's, rotated into it (no ω × r term, so a point
+        at rest in a turning frame has no velocity in it). A world frame keeps them; another unknown name raises
+        ModelError(``not_found``)."""
+        frame = self._entity_pose(frame_name)
         if frame is None:
-            if reference_frame in WORLD_FRAMES:
+            if frame_name in WORLD_FRAMES:
                 return pose, tuple(linear), tuple(angular)
-            raise ModelError("GetLinkState: reference reference_frame not found, did you forget to scope the link by "
-                             "model name?")
-        frame_linear, frame_angular = self._entity_twist(reference_frame)
+            raise ModelError(not_found)
+        frame_linear, frame_angular = self._entity_twist(frame_name)
         back = inverse(frame)
         return (compose(back, pose), rotate(back.orientation, np.subtract(linear, frame_linear)),
                 rotate(back.orientation, np.subtract(angular, frame_angular)))
+
+    def reference_pose(self, frame_name: str, not_found: str) -> Pose:
+        """The world pose of a request's reference frame: any model or "model::link", the world for "", "world",
+        "map" and "/map"; ModelError(``not_found``) for another name."""
+        frame = self._entity_pose(frame_name)
+        if frame is None:
+            if frame_name in WORLD_FRAMES:
+                return IDENTITY
+            raise ModelError(not_found)
+        return frame
+
+    def set_link_state(self, link_name: str, reference_frame: str, pose: Pose, linear, angular):
+        """set_link_state: link "model::link" put at ``pose`` with the (linear, angular) velocity of its origin,
+        all given in entity ``reference_frame`` as gazebo_ros takes them: the pose composed with the frame's, the
+        velocities minus the frame's, not rotated (upstream's arithmetic, kept).
+
+        Bullet moves a link of an articulated body only through its joints, so the whole model moves as one body
+        to put the link there, its joint positions unchanged (Gazebo moves the link alone and its joints pull it
+        and the rest together over the next steps). The model then turns about the link's origin with the given
+        twist: a robot's root link keeps the joints' velocities, as Gazebo's Link::SetLinearVel leaves the other
+        links', another link's model stops its joints, so that the link has exactly the given twist. A robot fixed
+        to the world (a root link "world") is refused: moving its links means moving its joints."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError("SetLinkState: link does not exist")
+        what = f"SetLinkState: link '{link_name}'"
+        check_state(what, pose, linear, angular)  # as sent: transformed, 1e300 would turn inf and NaN
+        frame = self._entity_pose(reference_frame)
+        if frame is not None:
+            frame_linear, frame_angular = self._entity_twist(reference_frame)
+            pose = compose(frame, pose)
+            linear, angular = tuple(np.subtract(linear, frame_linear)), tuple(np.subtract(angular, frame_angular))
+        elif reference_frame not in WORLD_FRAMES:
+            raise ModelError("SetLinkState: failed")
+        check_state(what, pose, linear, angular)
+        spawned = self.models.get(model)
+        if spawned is not None and spawned.robot.model.anchored:
+            raise ModelError(f"{what}: model '{model}' is fixed to the world, so its links move only through its "
+                             "joints (set_model_configuration); nothing was changed")
+        model_pose = self.engine.model_pose(model)
+        link_in_model = compose(inverse(model_pose), self._link_pose(model, link))
+        on_root = spawned is None or spawned.robot.link_index[spawned.robot.model.lumped_into[link][0]] == -1
+        self.engine.move_model(model, compose(pose, inverse(link_in_model)), pose.position, linear, angular,
+                               stop_joints=not on_root)
+        self.version += 1
 
     def model_properties(self, name: str) -> ModelProperties:
         """get_model_properties: the links and joints the physics has (a robot's after fixed-joint lumping, as

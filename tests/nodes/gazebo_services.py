@@ -1,0 +1,135 @@
+"""The /gazebo services beyond the mbot's own, run by test_ros_api.py in its world (a rostest <test> of their own
+would launch the world again): each is called through ROS
+once with good values and once with each kind of bad value, on a turntable spawned beside the mbot; the answer
+is success or upstream's message, and the mbot, a bystander, does not move."""
+import math
+import unittest
+
+import rospy
+from gazebo_msgs.msg import LinkState, LinkStates, ModelState
+from gazebo_msgs.srv import ApplyJointEffort, GetLinkState, GetModelState, JointRequest, SetLinkState, SpawnModel
+from geometry_msgs.msg import Pose
+
+from sim_support import Simulator, print_figures, wait_for
+
+TURNTABLE = """<robot name="table">
+  <link name="base_link">
+    <inertial><mass value="50"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><origin xyz="0 0 0.1"/><geometry><box size="0.6 0.6 0.2"/></geometry></collision>
+  </link>
+  <link name="plate">
+    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.02"/></geometry></collision>
+  </link>
+  <joint name="turntable" type="continuous"><parent link="base_link"/><child link="plate"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/></joint>
+</robot>"""
+PLATE = "table::plate"
+
+
+def service(name, service_type):
+    rospy.wait_for_service("/gazebo/" + name, timeout=30.0)
+    return rospy.ServiceProxy("/gazebo/" + name, service_type)
+
+
+class GazeboServices(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("ros_api_test")  # test_ros_api.py's node: one node per process
+        cls.sim = Simulator()
+        cls.sim.command(0.0, 0.0)
+        spawn = service("spawn_urdf_model", SpawnModel)
+        pose = Pose()
+        pose.position.x, pose.orientation.w = -2.0, 1.0
+        answer = spawn("table", TURNTABLE, "", pose, "world")
+        assert answer.success, answer.status_message
+        cls.link_state = service("get_link_state", GetLinkState)
+        wait_for(lambda: abs(cls.sim.truth()[2].linear.x) < 1e-3, what="the mbot at rest")
+
+    def assert_mbot_still(self, before):
+        _, pose, _ = self.sim.truth()
+        for axis in "xyz":
+            self.assertAlmostEqual(getattr(pose.position, axis), getattr(before.position, axis), delta=1e-4)
+
+    def plate_spin(self):
+        return self.link_state(PLATE, "table::base_link").link_state.twist.angular.z
+
+    def test_apply_joint_effort_and_clear_joint_forces(self):
+        apply_effort, clear = service("apply_joint_effort", ApplyJointEffort), service("clear_joint_forces",
+                                                                                       JointRequest)
+        _, mbot, _ = self.sim.truth()
+        for joint, effort in (("no_such_joint", 0.01), ("mbot::turntable", 0.01), ("turntable", math.nan),
+                              ("turntable", math.inf), ("turntable", -1e300)):
+            answer = apply_effort(joint, effort, rospy.Time(0), rospy.Duration(1.0))
+            self.assertFalse(answer.success, joint)
+            if "no_such" in joint or "mbot" in joint:
+                self.assertEqual(answer.status_message, "ApplyJointEffort: joint not found")
+            else:
+                self.assertIn("joint 'turntable': effort must be finite and at most 1e+06 in size; got ",
+                              answer.status_message)
+        self.assertLess(abs(self.plate_spin()), 1e-3, "a refused effort moved the plate")
+        answer = apply_effort("table::turntable", 0.01, rospy.Time(0), rospy.Duration(-1.0))  # until cleared
+        self.assertEqual((answer.success, answer.status_message), (True, "ApplyJointEffort: effort set"))
+        wait_for(lambda: self.plate_spin() > 0.2, what="the plate to spin up (1 rad/s² from 0.01 N·m)")
+        clear("turntable")
+        spin = self.plate_spin()
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() > start + 0.2, what="0.2 s of sim time")
+        self.assertLess(self.plate_spin(), spin * 1.01 + 1e-3, "the plate still sped up after clear_joint_forces")
+        print_figures([f"apply_joint_effort: plate at {spin:.2f} rad/s when cleared, "
+                       f"{self.plate_spin():.2f} rad/s 0.2 s later"])
+        self.assert_mbot_still(mbot)
+
+    def link_position(self, link):
+        position = self.link_state(link, "").link_state.pose.position
+        return position.x, position.y, position.z
+
+    def test_set_link_state_and_the_state_topics(self):
+        set_link = service("set_link_state", SetLinkState)
+        _, mbot, _ = self.sim.truth()
+        before = self.link_position("table::base_link")
+        for link, frame, value, message in (
+                ("table::lid", "", 1.0, "SetLinkState: link does not exist"),
+                ("plate", "", 1.0, "SetLinkState: link does not exist"),
+                ("table::base_link", "nowhere", 1.0, "SetLinkState: failed"),
+                ("table::base_link", "", math.nan, "position.x is nan, not a finite number"),
+                ("table::base_link", "", math.inf, "position.x is inf, not a finite number"),
+                ("table::base_link", "", 1e300, "position.x = 1e+300 is outside")):
+            state = LinkState(link_name=link, reference_frame=frame)
+            state.pose.position.x, state.pose.orientation.w = value, 1.0
+            answer = set_link(state)
+            self.assertFalse(answer.success, (link, frame, value))
+            self.assertIn(message, answer.status_message)
+        for got, expected in zip(self.link_position("table::base_link"), before):
+            self.assertAlmostEqual(got, expected, delta=1e-4)
+        # In the mbot's frame: 2 m ahead of it, 0.3 m up (where it falls from).
+        state = LinkState(link_name="table::base_link", reference_frame="mbot")
+        state.pose.position.x, state.pose.position.z, state.pose.orientation.w = 2.0, 0.3, 1.0
+        self.assertEqual(set_link(state).status_message, "SetLinkState: success")
+        relative = service("get_model_state", GetModelState)("table", "mbot")
+        self.assertAlmostEqual(relative.pose.position.x, 2.0, delta=1e-3)
+        self.assertEqual(service("get_model_state", GetModelState)("table", "table::lid").status_message,
+                         "GetModelState: reference relative_entity_name not found, did you forget to scope the body "
+                         "by model name?")
+        plate = service("get_model_state", GetModelState)("mbot", "table::plate")
+        self.assertTrue(plate.success, plate.status_message)
+        # The topics take the same requests.
+        model_topic = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=1, latch=True)
+        link_topic = rospy.Publisher("/gazebo/set_link_state", LinkState, queue_size=1, latch=True)
+        moved = ModelState(model_name="table")
+        moved.pose.position.x, moved.pose.position.y, moved.pose.position.z = -3.0, 0.0, 0.3
+        moved.pose.orientation.w = 1.0
+        model_topic.publish(moved)
+        wait_for(lambda: abs(self.link_position("table::base_link")[0] + 3.0) < 0.01,
+                 what="the table at x = -3 from /gazebo/set_model_state")
+        state = LinkState(link_name="table::base_link")
+        state.pose.position.x, state.pose.position.y, state.pose.position.z = -3.0, 2.0, 0.3
+        state.pose.orientation.w = 1.0
+        link_topic.publish(state)
+        wait_for(lambda: abs(self.link_position("table::base_link")[1] - 2.0) < 0.01,
+                 what="the table at y = 2 from /gazebo/set_link_state")
+        states = rospy.wait_for_message("/gazebo/link_states", LinkStates, timeout=30.0)
+        self.assertIn("mbot::base_footprint", states.name)
+        self.assertAlmostEqual(states.pose[states.name.index("table::base_link")].position.y, 2.0, delta=0.01)
+        self.assert_mbot_still(mbot)
+
