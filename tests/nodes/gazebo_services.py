@@ -6,8 +6,9 @@ import math
 import unittest
 
 import rospy
-from gazebo_msgs.msg import LinkState, LinkStates, ModelState
-from gazebo_msgs.srv import ApplyJointEffort, GetLinkState, GetModelState, JointRequest, SetLinkState, SpawnModel
+from gazebo_msgs.msg import LinkState, LinkStates, ModelState, ODEJointProperties
+from gazebo_msgs.srv import (ApplyJointEffort, GetJointProperties, GetLinkProperties, GetLinkState, GetModelState,
+                             JointRequest, SetJointProperties, SetLinkProperties, SetLinkState, SpawnModel)
 from geometry_msgs.msg import Pose
 
 from sim_support import Simulator, print_figures, wait_for
@@ -133,3 +134,42 @@ class GazeboServices(unittest.TestCase):
         self.assertAlmostEqual(states.pose[states.name.index("table::base_link")].position.y, 2.0, delta=0.01)
         self.assert_mbot_still(mbot)
 
+    def test_joint_and_link_properties(self):
+        get_link, set_link = service("get_link_properties", GetLinkProperties), service("set_link_properties",
+                                                                                       SetLinkProperties)
+        get_joint, set_joint = service("get_joint_properties", GetJointProperties), service("set_joint_properties",
+                                                                                          SetJointProperties)
+        _, mbot, _ = self.sim.truth()
+        plate = get_link("table::plate")
+        self.assertEqual((plate.success, plate.status_message, plate.mass), (True, "GetLinkProperties: got properties",
+                                                                            1.0))
+        self.assertEqual(get_link("plate").status_message,
+                         "GetLinkProperties: link not found, did you forget to scope the link by model name?")
+        fields = dict(com=plate.com, gravity_mode=True, ixx=plate.ixx, ixy=0.0, ixz=0.0, iyy=plate.iyy, iyz=0.0,
+                      izz=plate.izz)
+        for link, mass, message in (("table::lid", 1.0, "SetLinkProperties: link not found"),
+                                    ("table::plate", math.nan, "mass must be finite, above 0"),
+                                    ("table::plate", math.inf, "mass must be finite, above 0"),
+                                    ("table::plate", 1e300, "mass must be finite, above 0")):
+            answer = set_link(link_name=link, mass=mass, **fields)
+            self.assertFalse(answer.success, (link, mass))
+            self.assertIn(message, answer.status_message)
+        self.assertEqual(get_link("table::plate").mass, 1.0)
+        self.assertEqual(set_link(link_name="table::plate", mass=2.0, **fields).status_message,
+                         "SetLinkProperties: properties set")
+        self.assertEqual(get_link("table::plate").mass, 2.0)
+        joint = get_joint("turntable")
+        self.assertEqual((joint.success, joint.status_message, joint.type, joint.damping),
+                         (True, "GetJointProperties: got properties", joint.CONTINUOUS, (0.0,)))
+        self.assertEqual(get_joint("no_such_joint").status_message, "GetJointProperties: joint not found")
+        for name, damping, message in (("no_such_joint", 0.1, "SetJointProperties: joint not found"),
+                                       ("turntable", math.nan, "damping must be finite"),
+                                       ("turntable", math.inf, "damping must be finite"),
+                                       ("turntable", 1e300, "damping must be finite")):
+            answer = set_joint(name, ODEJointProperties(damping=[damping]))
+            self.assertFalse(answer.success, (name, damping))
+            self.assertIn(message, answer.status_message)
+        self.assertEqual(set_joint("table::turntable", ODEJointProperties(damping=[0.5])).status_message,
+                         "SetJointProperties: properties set")
+        self.assertEqual(get_joint("turntable").damping, (0.5,))
+        self.assert_mbot_still(mbot)

@@ -18,6 +18,9 @@ from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelPropert
                              SetModelConfiguration, SetModelConfigurationResponse)
 from gazebo_msgs.srv import ApplyJointEffort, ApplyJointEffortResponse, JointRequest, JointRequestResponse
 from gazebo_msgs.srv import SetLinkState, SetLinkStateResponse
+from gazebo_msgs.srv import (GetJointProperties, GetJointPropertiesResponse, GetLinkProperties,
+                             GetLinkPropertiesResponse, SetJointProperties, SetJointPropertiesResponse,
+                             SetLinkProperties, SetLinkPropertiesResponse)
 from gazebo_msgs.msg import LinkState, ModelState
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
@@ -25,6 +28,7 @@ from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
 from .core.engine import check_model_name, check_state
+from .core.entity_properties import LinkProperties
 from .core.errors import BridgeError, ModelError
 from .core.geometry import Pose, compose, rotate
 from .gazebo_paths import model_path
@@ -113,6 +117,10 @@ class GazeboRosApi:
             rospy.Service("~apply_joint_effort", ApplyJointEffort, self._apply_joint_effort),
             rospy.Service("~clear_joint_forces", JointRequest, self._clear_joint_forces),
             rospy.Service("~set_link_state", SetLinkState, self._set_link_state),
+            rospy.Service("~get_joint_properties", GetJointProperties, self._get_joint_properties),
+            rospy.Service("~set_joint_properties", SetJointProperties, self._set_joint_properties),
+            rospy.Service("~get_link_properties", GetLinkProperties, self._get_link_properties),
+            rospy.Service("~set_link_properties", SetLinkProperties, self._set_link_properties),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -321,6 +329,36 @@ class GazeboRosApi:
             state.pose, state.twist = _pose_to_message(pose), _twist_message(linear, angular)
             return response
         return self._guarded(GetLinkStateResponse, get)
+
+
+    # -- link and joint properties ---------------------------------------------------------------------------------
+    def _get_joint_properties(self, request):
+        def get():
+            properties = self.sim.joint_properties(request.joint_name)
+            return GetJointPropertiesResponse(**properties._asdict(), success=True,
+                                              status_message="GetJointProperties: got properties")
+        return self._guarded(GetJointPropertiesResponse, get)
+
+    def _set_joint_properties(self, request):
+        def set_properties():
+            self.sim.set_joint_properties(request.joint_name, request.ode_joint_config)
+            return SetJointPropertiesResponse(success=True, status_message="SetJointProperties: properties set")
+        return self._guarded(SetJointPropertiesResponse, set_properties)
+
+    def _get_link_properties(self, request):
+        def get():
+            properties = self.sim.link_properties(request.link_name)
+            return GetLinkPropertiesResponse(**properties._replace(com=_pose_to_message(properties.com))._asdict(),
+                                             success=True, status_message="GetLinkProperties: got properties")
+        return self._guarded(GetLinkPropertiesResponse, get)
+
+    def _set_link_properties(self, request):
+        def set_properties():
+            fields = {field: getattr(request, field) for field in LinkProperties._fields}
+            self.sim.set_link_properties(request.link_name, LinkProperties(**{
+                **fields, "com": _pose_from_message(request.com)}))
+            return SetLinkPropertiesResponse(success=True, status_message="SetLinkProperties: properties set")
+        return self._guarded(SetLinkPropertiesResponse, set_properties)
 
 
 def _refused(response_type, error: BridgeError):

@@ -303,6 +303,10 @@ class Engine:
         self._settling: Dict[int, List[int]] = {}
         self._wheels: Dict[int, WheelContacts] = {}  # per body, the friction of its wheels (wheel_contact)
         self._before_step: List[Callable[[], None]] = []
+        # set_joint_properties' damping: body -> joint index -> N·m·s/rad; set_link_properties' gravity_mode
+        # false: body -> link indices.
+        self._joint_damping: Dict[int, Dict[int, float]] = {}
+        self._weightless: Dict[int, set] = {}
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -335,6 +339,8 @@ class Engine:
         self._root_from_com.clear()
         self._settling.clear()
         self._wheels.clear()
+        self._joint_damping.clear()
+        self._weightless.clear()
         self._before_step = []
 
     @property
@@ -440,6 +446,9 @@ class Engine:
         self._settling.pop(body, None)
         self.collision_names.pop(body, None)
         self._set_wheels(body, None)
+        self._joint_damping.pop(body, None)
+        self._weightless.pop(body, None)
+        self._refresh_before_step()
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -680,7 +689,54 @@ class Engine:
             self._wheels.pop(body, None)
         else:
             self._wheels[body] = contacts
+        self._refresh_before_step()
+
+    def _refresh_before_step(self):
         self._before_step = [wheels.apply for wheels in self._wheels.values()]
+        if self._joint_damping:
+            self._before_step.append(self._damp_joints)
+        if self._weightless:
+            self._before_step.append(self._cancel_weights)
+
+    # -- link and joint properties set from outside (entity_properties) ------------------------------------------
+    def set_joint_damping(self, body: int, index: int, damping: float):
+        """A torque of -damping times the joint's rate before every step (0: none)."""
+        joints = self._joint_damping.setdefault(body, {})
+        joints[index] = damping
+        if not damping:
+            del joints[index]
+        if not joints:
+            del self._joint_damping[body]
+        self._refresh_before_step()
+
+    def joint_damping(self, body: int, index: int) -> float:
+        return self._joint_damping.get(body, {}).get(index, 0.0)
+
+    def set_weightless(self, body: int, index: int, weightless: bool):
+        """Whether a force cancels the link's weight before every step (Gazebo's gravity_mode false)."""
+        links = self._weightless.setdefault(body, set())
+        (links.add if weightless else links.discard)(index)
+        if not links:
+            del self._weightless[body]
+        self._refresh_before_step()
+
+    def weightless(self, body: int, index: int) -> bool:
+        return index in self._weightless.get(body, ())
+
+    def _damp_joints(self):
+        client = self.client
+        for body, joints in self._joint_damping.items():
+            for index, (_, rate, *_) in zip(joints, client.getJointStates(body, list(joints))):
+                client.setJointMotorControl2(body, index, pybullet.TORQUE_CONTROL, force=-joints[index] * rate)
+
+    def _cancel_weights(self):
+        client, gravity = self.client, self.physics.gravity
+        for body, links in self._weightless.items():
+            for index in links:
+                mass = client.getDynamicsInfo(body, index)[0]
+                centre = (client.getBasePositionAndOrientation(body)[0] if index == -1
+                          else client.getLinkState(body, index)[0])
+                client.applyExternalForce(body, index, [-mass * g for g in gravity], centre, pybullet.WORLD_FRAME)
 
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, modelled: bool):
         mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")

@@ -20,6 +20,8 @@ from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
 from .engine import Engine, check_state, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
+from . import entity_properties
+from .entity_properties import JointProperties, LinkProperties
 from .joints import joint_efforts
 from .joints.joint_efforts import JointEfforts
 from .joints.model_configuration import requested_positions
@@ -82,6 +84,9 @@ class Simulation:
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
         self.joint_efforts = JointEfforts()  # apply_joint_effort's
+        # How to undo each link's and joint's properties set from outside, for reset_world: (model, name) -> undo.
+        self._property_undo: Dict[Tuple[str, str], Callable[[], None]] = {}
+        self._joint_limits: Dict[Tuple[str, str], Tuple[float, float]] = {}  # set by set_joint_properties
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -169,6 +174,9 @@ class Simulation:
         self.world_models.pop(name, None)
         self.wrenches.clear(name)
         self.joint_efforts.clear(name)
+        for key in [key for key in self._property_undo if key[0] == name]:
+            del self._property_undo[key]
+        self._joint_limits = {key: value for key, value in self._joint_limits.items() if key[0] != name}
         self.engine.remove(name)
         self.version += 1
 
@@ -310,6 +318,104 @@ class Simulation:
         self.engine.move_model(model, compose(pose, inverse(link_in_model)), pose.position, linear, angular,
                                stop_joints=not on_root)
         self.version += 1
+
+    # -- link and joint properties (entity_properties) ---------------------------------------------------------------
+    def _physics_link(self, link_name: str, not_found: str) -> Tuple[str, str, int, Optional[int]]:
+        """(model, link, body, Bullet link index) of a "model::link"; the index is None for a link of a world model
+        with several links (welded into the body's base). ModelError(``not_found``) when there is no such link."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError(not_found)
+        body = self.engine.body_of(model)
+        if model in self.models:
+            return model, link, body, self.models[model].robot.link_index[link]
+        return model, link, body, -1 if len(self.world_models[model].links) == 1 else None
+
+    def link_properties(self, link_name: str) -> LinkProperties:
+        """get_link_properties (entity_properties' module docstring)."""
+        model, link, body, index = self._physics_link(
+            link_name, "GetLinkProperties: link not found, did you forget to scope the link by model name?")
+        if index is None:
+            described = next(item for item in self.world_models[model].links if item.name == link)
+            ixx, ixy, ixz, iyy, iyz, izz = described.inertia
+            return LinkProperties(described.inertial_pose, True, described.mass, ixx, ixy, ixz, iyy, iyz, izz)
+        mass, _, (ixx, iyy, izz), position, orientation = self.engine.client.getDynamicsInfo(body, index)[:5]
+        com = Pose(tuple(position), tuple(orientation))  # in the Bullet link's frame: a world model's base is its own
+        if model in self.world_models:
+            described = self.world_models[model]
+            com = compose(inverse(compose(inverse(described.pose), described.links[0].pose)), com)
+        return LinkProperties(com, not self.engine.weightless(body, index), mass, ixx, 0.0, 0.0, iyy, 0.0, izz)
+
+    def set_link_properties(self, link_name: str, requested: LinkProperties):
+        """set_link_properties: mass, the moments about the inertia's axes and gravity_mode (entity_properties'
+        module docstring); ModelError with upstream's message for an unknown link, naming the value for a bad one."""
+        model, link, body, index = self._physics_link(
+            link_name, "SetLinkProperties: link not found, did you forget to scope the link by model name?")
+        if index is None:
+            raise ModelError(f"SetLinkProperties: link '{link_name}': the links of world model '{model}' are welded "
+                             "into one body here; only a one-link model's properties can change")
+        current = self.link_properties(link_name)
+        mass, moments, frame_changed = entity_properties.checked_link_properties(link_name, requested, current)
+        if frame_changed:
+            warn_once(_logger, f"SetLinkProperties: link '{link_name}': Bullet keeps a link's centre of mass and "
+                               "inertia axes; the mass and the moments about its axes are set, the rest ignored")
+        client = self.engine.client
+        if (model, link) not in self._property_undo:
+            weightless = self.engine.weightless(body, index)
+
+            def undo():
+                client.changeDynamics(body, index, mass=current.mass, localInertiaDiagonal=(
+                    current.ixx, current.iyy, current.izz))
+                self.engine.set_weightless(body, index, weightless)
+            self._property_undo[(model, link)] = undo
+        client.changeDynamics(body, index, mass=mass, localInertiaDiagonal=moments)
+        self.engine.set_weightless(body, index, not requested.gravity_mode)
+
+    def _joint(self, joint_name: str, not_found: str) -> Tuple[str, str]:
+        movable = [(name, spawned.robot.movable_joints) for name, spawned in self.models.items()]
+        found = joint_efforts.find_joint(joint_name, movable)
+        if found is None:
+            raise ModelError(not_found)
+        return found
+
+    def joint_properties(self, joint_name: str) -> JointProperties:
+        """get_joint_properties: the joint's type (upstream always says REVOLUTE), the damping set_joint_properties
+        gave it, its position and rate."""
+        model, joint = self._joint(joint_name, "GetJointProperties: joint not found")
+        robot = self.models[model].robot
+        position, rate, _ = robot.joint_state([joint])[0]
+        damping = self.engine.joint_damping(robot.body, robot.joint_index[joint])
+        return JointProperties(entity_properties.JOINT_TYPES[robot.model.joints[joint].type], [damping], [position],
+                               [rate])
+
+    def set_joint_properties(self, joint_name: str, config):
+        """set_joint_properties with ODEJointProperties ``config`` (entity_properties' module docstring)."""
+        model, joint = self._joint(joint_name, "SetJointProperties: joint not found")
+        robot = self.models[model].robot
+        index = robot.joint_index[joint]
+        client = self.engine.client
+        lower, upper = client.getJointInfo(robot.body, index)[8:10]
+        if lower > upper:  # no limits; Bullet's stops, once set, are put out of reach instead (they stay)
+            lower, upper = -entity_properties.NO_STOP, entity_properties.NO_STOP
+        limits = self._joint_limits.get((model, joint), (lower, upper))
+        settings = entity_properties.checked_joint_settings(joint_name, config, *limits)
+        if settings.ignored:
+            warn_once(_logger, f"SetJointProperties: joint '{joint_name}': {', '.join(settings.ignored)} have no "
+                               "Bullet counterpart; ignored")
+        if (model, joint) not in self._property_undo:
+            def undo():
+                self.engine.set_joint_damping(robot.body, index, 0.0)
+                client.changeDynamics(robot.body, index, jointLowerLimit=lower, jointUpperLimit=upper)
+                self._joint_limits.pop((model, joint), None)
+            self._property_undo[(model, joint)] = undo
+        if settings.damping is not None:
+            self.engine.set_joint_damping(robot.body, index, settings.damping)
+        if settings.limits is not None:
+            client.changeDynamics(robot.body, index, jointLowerLimit=settings.limits[0],
+                                  jointUpperLimit=settings.limits[1])
+            self._joint_limits[(model, joint)] = settings.limits
+        if settings.motor is not None:
+            robot.set_joint_velocity(joint, *settings.motor)
 
     def model_properties(self, name: str) -> ModelProperties:
         """get_model_properties: the links and joints the physics has (a robot's after fixed-joint lumping, as
@@ -518,6 +624,9 @@ class Simulation:
             for sequence, generator in self._streams.values():
                 generator.bit_generator.state = np.random.PCG64(sequence).state
         else:
+            for undo in self._property_undo.values():
+                undo()
+            self._forget_set_properties()
             self.engine.reset_world()
         self._frozen.clear()
         # Resets repair what service calls left: wrenches and efforts "until cleared" too.
@@ -531,6 +640,7 @@ class Simulation:
     def _rebuild(self):
         """Every model built again in its original order, as a new run would: see Engine.restart."""
         self.engine.restart()
+        self._forget_set_properties()  # the models are loaded as described
         for entry in self._build_order:
             if isinstance(entry, str):
                 self.engine.respawn(self.models[entry].robot)
@@ -539,6 +649,10 @@ class Simulation:
             else:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
                 self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
+
+    def _forget_set_properties(self):
+        self._property_undo.clear()
+        self._joint_limits.clear()
 
     def __enter__(self) -> "Simulation":
         return self
