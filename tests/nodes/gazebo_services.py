@@ -8,7 +8,8 @@ import unittest
 import rospy
 from gazebo_msgs.msg import LinkState, LinkStates, ModelState, ODEJointProperties
 from gazebo_msgs.srv import (ApplyJointEffort, GetJointProperties, GetLinkProperties, GetLinkState, GetModelState,
-                             JointRequest, SetJointProperties, SetLinkProperties, SetLinkState, SpawnModel)
+                             GetPhysicsProperties, JointRequest, SetJointProperties, SetLinkProperties, SetLinkState,
+                             SetPhysicsProperties, SpawnModel)
 from geometry_msgs.msg import Pose
 
 from sim_support import Simulator, print_figures, wait_for
@@ -172,4 +173,29 @@ class GazeboServices(unittest.TestCase):
         self.assertEqual(set_joint("table::turntable", ODEJointProperties(damping=[0.5])).status_message,
                          "SetJointProperties: properties set")
         self.assertEqual(get_joint("turntable").damping, (0.5,))
+        self.assert_mbot_still(mbot)
+
+    def test_physics_properties(self):
+        get, set_physics = service("get_physics_properties", GetPhysicsProperties), service(
+            "set_physics_properties", SetPhysicsProperties)
+        world = get()
+        self.assertEqual((world.status_message, world.ode_config.sor_pgs_iters, world.ode_config.erp),
+                         ("GetPhysicsProperties: got properties", 50, 0.2))
+        _, mbot, _ = self.sim.truth()
+        gravity = world.gravity
+        for time_step, z, message in ((math.nan, -9.8, "time_step must be finite"),
+                                      (1e300, -9.8, "time_step must be finite"),
+                                      (0.001, math.inf, "gravity.z must be finite"),
+                                      (0.001, -1e300, "gravity.z must be finite")):
+            gravity.z = z
+            answer = set_physics(time_step, world.max_update_rate, gravity, world.ode_config)
+            self.assertFalse(answer.success)
+            self.assertIn(message, answer.status_message)
+        self.assertEqual(get().gravity.z, -9.8)
+        gravity.z = -5.0
+        answer = set_physics(world.time_step, world.max_update_rate, gravity, world.ode_config)
+        self.assertEqual((answer.success, answer.status_message), (True, "physics engine updated"))
+        self.assertEqual(get().gravity.z, -5.0)
+        gravity.z = -9.8  # back, for the tests that follow in this world
+        self.assertTrue(set_physics(world.time_step, world.max_update_rate, gravity, world.ode_config).success)
         self.assert_mbot_still(mbot)

@@ -21,7 +21,8 @@ from gazebo_msgs.srv import SetLinkState, SetLinkStateResponse
 from gazebo_msgs.srv import (GetJointProperties, GetJointPropertiesResponse, GetLinkProperties,
                              GetLinkPropertiesResponse, SetJointProperties, SetJointPropertiesResponse,
                              SetLinkProperties, SetLinkPropertiesResponse)
-from gazebo_msgs.msg import LinkState, ModelState
+from gazebo_msgs.msg import LinkState, ModelState, ODEPhysics
+from gazebo_msgs.srv import SetPhysicsProperties, SetPhysicsPropertiesResponse
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
@@ -29,6 +30,7 @@ from std_srvs.srv import Empty, EmptyResponse
 
 from .core.engine import check_model_name, check_state
 from .core.entity_properties import LinkProperties
+from .core.physics_properties import OdeConfig
 from .core.errors import BridgeError, ModelError
 from .core.geometry import Pose, compose, rotate
 from .gazebo_paths import model_path
@@ -104,6 +106,7 @@ class GazeboRosApi:
             rospy.Service("~set_model_state", SetModelState, self._set_model_state),
             rospy.Service("~get_world_properties", GetWorldProperties, self._get_world_properties),
             rospy.Service("~get_physics_properties", GetPhysicsProperties, self._get_physics_properties),
+            rospy.Service("~set_physics_properties", SetPhysicsProperties, self._set_physics_properties),
             rospy.Service("~pause_physics", Empty, self._empty(lambda: node.set_paused(True))),
             rospy.Service("~unpause_physics", Empty, self._empty(lambda: node.set_paused(False))),
             rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
@@ -271,7 +274,8 @@ class GazeboRosApi:
     def _get_world_properties(self, _request):
         def get():
             return GetWorldPropertiesResponse(sim_time=self.sim.sim_time, model_names=self.sim.model_names(),
-                                              rendering_enabled=True, success=True, status_message="")
+                                              rendering_enabled=True, success=True,
+                                              status_message="GetWorldProperties: got properties")
         return self._guarded(GetWorldPropertiesResponse, get)
 
     def _get_physics_properties(self, _request):
@@ -279,13 +283,20 @@ class GazeboRosApi:
             physics = self.sim.engine.physics
             response = GetPhysicsPropertiesResponse(time_step=physics.max_step_size, pause=self.sim.paused,
                                                     max_update_rate=physics.real_time_update_rate,
-                                                    success=True, status_message="")
+                                                    ode_config=ODEPhysics(**self.sim.ode_config()._asdict()),
+                                                    success=True, status_message="GetPhysicsProperties: got properties")
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
-            ode = response.ode_config
-            ode.erp, ode.contact_max_correcting_vel = physics.erp, physics.contact_max_correcting_vel
-            ode.contact_surface_layer = physics.contact_surface_layer
             return response
         return self._guarded(GetPhysicsPropertiesResponse, get)
+
+    def _set_physics_properties(self, request):
+        def set_physics():
+            gravity = (request.gravity.x, request.gravity.y, request.gravity.z)
+            ode = OdeConfig(**{field: getattr(request.ode_config, field) for field in OdeConfig._fields})
+            self.sim.set_physics(request.time_step, request.max_update_rate, gravity, ode)
+            self.node.physics_changed()
+            return SetPhysicsPropertiesResponse(success=True, status_message="physics engine updated")
+        return self._guarded(SetPhysicsPropertiesResponse, set_physics)
 
     # -- joints --------------------------------------------------------------------------------------------------
     def _apply_joint_effort(self, request):

@@ -47,6 +47,8 @@ PENETRATION_TOLERANCE = 1.0e-5  # m
 # A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
 # stay finite below it.
 MAX_WHEEL_MU = 1.0e3
+# PyBullet's own number of solver iterations (ODE's <iters> default is the same).
+DEFAULT_SOLVER_ITERATIONS = 50
 # PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
 # every query fails ("GetBasePositionAndOrientation failed").
 MAX_BODY_LINKS = 128
@@ -288,8 +290,11 @@ class Engine:
     def __init__(self, physics: PhysicsConfig = PhysicsConfig(), connection_mode: int = pybullet.DIRECT):
         self.client = CachingBulletClient(connection_mode=connection_mode)
         self.physics = physics
+        self.solver_iterations = DEFAULT_SOLVER_ITERATIONS  # ODE's <iters>, set_physics_properties' sor_pgs_iters
         self._configure()
         self.steps = 0
+        # Sim time at step 0 of the current step size: set_physics_properties changes the step size mid-run.
+        self.time_offset = 0.0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
@@ -320,7 +325,8 @@ class Engine:
         # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
         # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
         # into what it touches and moved the skid-steer turn figures by 1 %.
-        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp)
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp,
+                                              numSolverIterations=self.solver_iterations)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -331,6 +337,7 @@ class Engine:
         self.client.resetSimulation()
         self._configure()
         self.steps = 0
+        self.time_offset = 0.0
         self.robots.clear()
         self.world_bodies.clear()
         self.dynamic_world_bodies.clear()
@@ -345,7 +352,15 @@ class Engine:
 
     @property
     def sim_time(self) -> float:
-        return self.steps * self.physics.max_step_size
+        return self.time_offset + self.steps * self.physics.max_step_size
+
+    def set_physics(self, physics: PhysicsConfig, solver_iterations: int):
+        """New physics settings between two steps (set_physics_properties); sim time goes on from where it is."""
+        self.time_offset = self.sim_time - self.steps * physics.max_step_size
+        self.physics, self.solver_iterations = physics, solver_iterations
+        self._configure()
+        for robot in self.robots.values():  # the wheel contact model is made for one step size
+            self.set_surfaces(robot, robot.driven_joints)
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
         """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of

@@ -20,7 +20,7 @@ from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
 from .engine import Engine, check_state, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
-from . import entity_properties
+from . import entity_properties, physics_properties
 from .entity_properties import JointProperties, LinkProperties
 from .joints import joint_efforts
 from .joints.joint_efforts import JointEfforts
@@ -319,6 +319,19 @@ class Simulation:
                                stop_joints=not on_root)
         self.version += 1
 
+    # -- physics (physics_properties) ----------------------------------------------------------------------------------
+    def ode_config(self) -> physics_properties.OdeConfig:
+        return physics_properties.ode_config(self.engine.physics, self.engine.solver_iterations)
+
+    def set_physics(self, time_step: float, max_update_rate: float, gravity, ode: physics_properties.OdeConfig):
+        """set_physics_properties (physics_properties' module docstring); ModelError naming a bad value."""
+        physics, iterations, ignored = physics_properties.requested_physics(self.engine.physics, time_step,
+                                                                            max_update_rate, gravity, ode)
+        if ignored:
+            warn_once(_logger, f"SetPhysicsProperties: {', '.join(ignored)}: no Bullet counterpart; ignored")
+        self.engine.set_physics(physics, iterations)
+        self._schedule()  # plugins that act every step take the new step size
+
     # -- link and joint properties (entity_properties) ---------------------------------------------------------------
     def _physics_link(self, link_name: str, not_found: str) -> Tuple[str, str, int, Optional[int]]:
         """(model, link, body, Bullet link index) of a "model::link"; the index is None for a link of a world model
@@ -564,9 +577,9 @@ class Simulation:
         moving = [name for name in self.engine.model_names() if name not in names and not (
             name in self.world_models and self.world_models[name].static)]
         kept = {name: state for name, state in self.engine.body_states(moving).items() if state.finite}
-        steps = self.engine.steps
+        steps, time_offset = self.engine.steps, self.engine.time_offset
         self._rebuild()
-        self.engine.steps = steps
+        self.engine.steps, self.engine.time_offset = steps, time_offset
         for name, state in kept.items():
             self.engine.restore_body_state(name, state)
         self._frozen.update(names)
