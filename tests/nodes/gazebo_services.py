@@ -6,6 +6,8 @@ import math
 import unittest
 
 import rospy
+from dynamic_reconfigure.msg import Config, ConfigDescription, DoubleParameter
+from dynamic_reconfigure.srv import Reconfigure
 from gazebo_msgs.msg import LinkState, LinkStates, ModelState, ODEJointProperties
 from gazebo_msgs.srv import (ApplyJointEffort, GetJointProperties, GetLinkProperties, GetLinkState, GetModelState,
                              GetPhysicsProperties, JointRequest, SetJointProperties, SetLinkProperties, SetLinkState,
@@ -43,7 +45,8 @@ class GazeboServices(unittest.TestCase):
         spawn = service("spawn_urdf_model", SpawnModel)
         pose = Pose()
         pose.position.x, pose.orientation.w = -2.0, 1.0
-        answer = spawn("table", TURNTABLE, "", pose, "world")
+        # In a namespace of its own: its joint_states are not the mbot's robot_state_publisher's.
+        answer = spawn("table", TURNTABLE, "/table", pose, "world")
         assert answer.success, answer.status_message
         cls.link_state = service("get_link_state", GetLinkState)
         wait_for(lambda: abs(cls.sim.truth()[2].linear.x) < 1e-3, what="the mbot at rest")
@@ -196,6 +199,20 @@ class GazeboServices(unittest.TestCase):
         answer = set_physics(world.time_step, world.max_update_rate, gravity, world.ode_config)
         self.assertEqual((answer.success, answer.status_message), (True, "physics engine updated"))
         self.assertEqual(get().gravity.z, -5.0)
+        # The physics dynamic_reconfigure takes the same: a change, then a value the physics refuses.
+        reconfigure = service("set_parameters", Reconfigure)
+        description = rospy.wait_for_message("/gazebo/parameter_descriptions", ConfigDescription, timeout=30.0)
+        self.assertIn("contact_max_correcting_vel", [item.name for item in description.groups[0].parameters])
+
+        def gravity_z(answer):
+            return next(item.value for item in answer.config.doubles if item.name == "gravity_z")
+        self.assertEqual(gravity_z(reconfigure(Config(doubles=[DoubleParameter("gravity_z", -6.0)]))), -6.0)
+        self.assertEqual((get().gravity.z, rospy.get_param("/gazebo/gravity_z")), (-6.0, -6.0))
+        refused = reconfigure(Config(doubles=[DoubleParameter("gravity_z", math.nan)]))
+        self.assertEqual(gravity_z(refused), -6.0)
+        self.assertEqual(get().gravity.z, -6.0)
+        updates = rospy.wait_for_message("/gazebo/parameter_updates", Config, timeout=30.0)
+        self.assertEqual(next(item.value for item in updates.doubles if item.name == "gravity_z"), -6.0)
         gravity.z = -9.8  # back, for the tests that follow in this world
         self.assertTrue(set_physics(world.time_step, world.max_update_rate, gravity, world.ode_config).success)
         self.assert_mbot_still(mbot)

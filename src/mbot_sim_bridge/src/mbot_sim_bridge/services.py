@@ -39,6 +39,7 @@ from .core.description.sdf_spawn import spawn_world_xml
 from .core.description.sdf_world import parse_world
 from .model_states import LinkStatesPublisher, ModelStatesPublisher
 from .package_uris import resolve_package_uris
+from .physics_reconfigure import PhysicsReconfigure
 from .plugins import ros_time
 from .subscriptions import drain
 from .world_saving import SaveWorldHandler
@@ -91,6 +92,7 @@ class GazeboRosApi:
         self.sim = node.sim
         self.model_states = ModelStatesPublisher(self.sim)
         self.link_states = LinkStatesPublisher(self.sim)
+        self.physics_reconfigure = PhysicsReconfigure(node)
         # As upstream's: the topics take the services' requests, and a refused one is only logged.
         self._subscribers = [
             rospy.Subscriber("~set_model_state", ModelState, lambda state: self._set_model_state(
