@@ -8,11 +8,12 @@ import unittest
 import rospy
 from dynamic_reconfigure.msg import Config, ConfigDescription, DoubleParameter
 from dynamic_reconfigure.srv import Reconfigure
-from gazebo_msgs.msg import LinkState, LinkStates, ModelState, ODEJointProperties
-from gazebo_msgs.srv import (ApplyJointEffort, GetJointProperties, GetLinkProperties, GetLinkState, GetModelState,
-                             GetPhysicsProperties, JointRequest, SetJointProperties, SetLinkProperties, SetLinkState,
-                             SetPhysicsProperties, SpawnModel)
-from geometry_msgs.msg import Pose
+from gazebo_msgs.msg import LinkState, LinkStates, ModelState, ODEJointProperties, PerformanceMetrics
+from gazebo_msgs.srv import (ApplyJointEffort, DeleteLight, GetJointProperties, GetLightProperties, GetLinkProperties,
+                             GetLinkState, GetModelState, GetPhysicsProperties, JointRequest, SetJointProperties,
+                             SetLightProperties, SetLinkProperties, SetLinkState, SetPhysicsProperties, SpawnModel)
+from geometry_msgs.msg import Pose, Vector3
+from std_msgs.msg import ColorRGBA
 
 from sim_support import Simulator, print_figures, wait_for
 
@@ -216,3 +217,33 @@ class GazeboServices(unittest.TestCase):
         gravity.z = -9.8  # back, for the tests that follow in this world
         self.assertTrue(set_physics(world.time_step, world.max_update_rate, gravity, world.ode_config).success)
         self.assert_mbot_still(mbot)
+
+    def test_lights_and_performance_metrics(self):
+        get, set_light, delete = (service("get_light_properties", GetLightProperties),
+                                  service("set_light_properties", SetLightProperties),
+                                  service("delete_light", DeleteLight))
+        sun = get("sun")  # empty.world's model://sun, as Gazebo's
+        self.assertEqual(sun.success, True)
+        self.assertAlmostEqual(sun.diffuse.r, 0.8, places=6)  # ColorRGBA is float32
+        self.assertEqual(sun.attenuation_constant, 0.9)
+        self.assertEqual(get("lamp").status_message, "getLightProperties: Requested light lamp not found!")
+        pose = Pose()
+        pose.orientation.w = 1.0
+        for light, value, message in (("lamp", 0.5, "setLightProperties: Requested light lamp not found!"),
+                                      ("sun", math.nan, "diffuse must be finite"),
+                                      ("sun", math.inf, "diffuse must be finite"),
+                                      ("sun", 1e30, "diffuse must be finite")):  # float32: 1e300 is unsendable
+            answer = set_light(light, True, ColorRGBA(value, 0.0, 0.0, 1.0), ColorRGBA(), 1.0, 0.0, 0.0,
+                               Vector3(-0.5, 0.1, -0.9), pose)
+            self.assertFalse(answer.success, (light, value))
+            self.assertIn(message, answer.status_message)
+        self.assertAlmostEqual(get("sun").diffuse.r, 0.8, places=6)
+        self.assertTrue(set_light("sun", True, ColorRGBA(0.5, 0.5, 0.5, 1.0), ColorRGBA(), 1.0, 0.0, 0.0,
+                                  Vector3(-0.5, 0.1, -0.9), pose).success)
+        self.assertEqual(get("sun").diffuse.r, 0.5)
+        self.assertEqual(delete("sun").status_message, "DeleteLight: sun successfully deleted")
+        self.assertEqual(delete("sun").status_message, "DeleteLight: Requested light sun not found!")
+        metrics = rospy.wait_for_message("/gazebo/performance_metrics", PerformanceMetrics, timeout=30.0)
+        print_figures([f"performance_metrics: real_time_factor {metrics.real_time_factor:.3f}"])
+        self.assertGreater(metrics.real_time_factor, 0.2)
+        self.assertLess(metrics.real_time_factor, 1.1)

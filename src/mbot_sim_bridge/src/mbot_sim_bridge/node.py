@@ -173,6 +173,7 @@ class SimBridgeNode:
             rospy.rostime._set_rostime(stamp)
         self.api.model_states.publish()
         self.api.link_states.publish()
+        self.api.performance_metrics.publish()
         # The timer guarantees the longest gap between two /clock messages, counted from the last one.
         self.clock_timer.reset(now)
         self._last_clock = now

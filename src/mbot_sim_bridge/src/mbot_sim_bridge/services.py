@@ -23,6 +23,9 @@ from gazebo_msgs.srv import (GetJointProperties, GetJointPropertiesResponse, Get
                              SetLinkProperties, SetLinkPropertiesResponse)
 from gazebo_msgs.msg import LinkState, ModelState, ODEPhysics
 from gazebo_msgs.srv import SetPhysicsProperties, SetPhysicsPropertiesResponse
+from gazebo_msgs.srv import (DeleteLight, DeleteLightResponse, GetLightProperties, GetLightPropertiesResponse,
+                             SetLightProperties, SetLightPropertiesResponse)
+from std_msgs.msg import ColorRGBA
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
@@ -39,6 +42,7 @@ from .core.description.sdf_spawn import spawn_world_xml
 from .core.description.sdf_world import parse_world
 from .model_states import LinkStatesPublisher, ModelStatesPublisher
 from .package_uris import resolve_package_uris
+from .performance_metrics import PerformanceMetricsPublisher
 from .physics_reconfigure import PhysicsReconfigure
 from .plugins import ros_time
 from .subscriptions import drain
@@ -75,6 +79,10 @@ def _pose_to_message(pose: Pose) -> PoseMessage:
     return message
 
 
+def _colour(colour: ColorRGBA):
+    return colour.r, colour.g, colour.b, colour.a
+
+
 def _twist_vectors(twist: Twist):
     return ((twist.linear.x, twist.linear.y, twist.linear.z), (twist.angular.x, twist.angular.y, twist.angular.z))
 
@@ -92,6 +100,7 @@ class GazeboRosApi:
         self.sim = node.sim
         self.model_states = ModelStatesPublisher(self.sim)
         self.link_states = LinkStatesPublisher(self.sim)
+        self.performance_metrics = PerformanceMetricsPublisher(self.sim)
         self.physics_reconfigure = PhysicsReconfigure(node)
         # As upstream's: the topics take the services' requests, and a refused one is only logged.
         self._subscribers = [
@@ -126,6 +135,9 @@ class GazeboRosApi:
             rospy.Service("~set_joint_properties", SetJointProperties, self._set_joint_properties),
             rospy.Service("~get_link_properties", GetLinkProperties, self._get_link_properties),
             rospy.Service("~set_link_properties", SetLinkProperties, self._set_link_properties),
+            rospy.Service("~get_light_properties", GetLightProperties, self._get_light_properties),
+            rospy.Service("~set_light_properties", SetLightProperties, self._set_light_properties),
+            rospy.Service("~delete_light", DeleteLight, self._delete_light),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -372,6 +384,34 @@ class GazeboRosApi:
                 **fields, "com": _pose_from_message(request.com)}))
             return SetLinkPropertiesResponse(success=True, status_message="SetLinkProperties: properties set")
         return self._guarded(SetLinkPropertiesResponse, set_properties)
+
+    # -- lights (kept, not rendered: core/lights.py) -------------------------------------------------------------------
+    def _get_light_properties(self, request):
+        def get():
+            light = self.sim.lights.get(request.light_name)
+            constant, linear, quadratic = light.attenuation
+            # Upstream answers success with no status message.
+            return GetLightPropertiesResponse(diffuse=ColorRGBA(*light.diffuse), attenuation_constant=constant,
+                                              attenuation_linear=linear, attenuation_quadratic=quadratic,
+                                              success=True)
+        return self._guarded(GetLightPropertiesResponse, get)
+
+    def _set_light_properties(self, request):
+        def set_properties():
+            direction = request.direction
+            self.sim.lights.set(request.light_name, request.cast_shadows, _colour(request.diffuse),
+                                _colour(request.specular), (request.attenuation_constant, request.attenuation_linear,
+                                                           request.attenuation_quadratic),
+                                (direction.x, direction.y, direction.z), _pose_from_message(request.pose))
+            return SetLightPropertiesResponse(success=True)
+        return self._guarded(SetLightPropertiesResponse, set_properties)
+
+    def _delete_light(self, request):
+        def delete():
+            self.sim.lights.delete(request.light_name)
+            return DeleteLightResponse(success=True,
+                                       status_message=f"DeleteLight: {request.light_name} successfully deleted")
+        return self._guarded(DeleteLightResponse, delete)
 
 
 def _refused(response_type, error: BridgeError):

@@ -25,6 +25,7 @@ from .entity_properties import JointProperties, LinkProperties
 from .joints import joint_efforts
 from .joints.joint_efforts import JointEfforts
 from .joints.model_configuration import requested_positions
+from .lights import Lights, world_lights
 from .log import get_logger, warn_once
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext, SpawnedModel
@@ -87,6 +88,8 @@ class Simulation:
         # How to undo each link's and joint's properties set from outside, for reset_world: (model, name) -> undo.
         self._property_undo: Dict[Tuple[str, str], Callable[[], None]] = {}
         self._joint_limits: Dict[Tuple[str, str], Tuple[float, float]] = {}  # set by set_joint_properties
+        self.lights = Lights(world_lights(world.others))
+        self.sensor_updates: Dict[Plugin, int] = {}  # updates of each sensor plugin so far (performance_metrics)
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -164,6 +167,7 @@ class Simulation:
         if spawned is not None:
             for plugin in spawned.plugins:
                 plugin.close()
+                self.sensor_updates.pop(plugin, None)
             if self.viewer is not None:
                 self.viewer.forget_robot(spawned.robot)
             for key in [key for key in self._streams if key.startswith(name + "/")]:
@@ -557,8 +561,11 @@ class Simulation:
         due = [plugin for plugin in self._plugins if self._guarded(plugin, plugin.timer.due, now)]
         if before_updates is not None:
             before_updates(now, bool(due))
+        counts = self.sensor_updates
         for plugin in due:
             self._guarded(plugin, plugin.update, now)
+            if plugin.sensor is not None:
+                counts[plugin] = counts.get(plugin, 0) + 1
         if self.viewer is not None:
             self.viewer.follow()
         return count
