@@ -11,6 +11,7 @@ import pytest
 from gazebo_msgs.msg import LinkStates
 from sensor_fixtures import world_simulation
 from test_joint_efforts import CRATE, TURNTABLE
+from test_model_states import CountedConnections
 
 from mbot_sim_bridge import model_states
 from mbot_sim_bridge.core.description.robot_model import parse_robot
@@ -116,17 +117,6 @@ def test_model_state_relative_to_a_link_is_upstreams(world):
     with pytest.raises(ModelError, match="^GetModelState: reference relative_entity_name not found, did you forget "
                                          "to scope the body by model name\\?$"):
         sim.model_state("crate", "table::lid")
-
-
-class CountedConnections:
-    def __init__(self, name, message_type):
-        self.connections, self.sent = 0, []
-
-    def get_num_connections(self):
-        return self.connections
-
-    def publish(self, message):
-        self.sent.append(message)
 
 
 def test_link_states_are_every_links_state_and_sent_only_while_subscribed(world, monkeypatch):

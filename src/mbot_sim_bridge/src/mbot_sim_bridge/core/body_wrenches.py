@@ -20,15 +20,12 @@ import numpy as np
 
 from .errors import ModelError
 from .geometry import Pose, Vector, inverse, compose, rotate
-from .timed_jobs import TimedJobs
+from .timed_jobs import TimedJobs, check_window
 
 ZERO = (0.0, 0.0, 0.0)
 WORLD_FRAMES = ("", "world", "map", "/map")
 # apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
 MAX_WRENCH = 1e6
-# Its largest start time and duration (s): what a ROS time or duration can carry (a uint32 or int32 of seconds),
-# so every request through ROS passes, and a start of 1e308 s cannot overflow the loop's count of steps to it.
-MAX_WRENCH_TIME = 2.0 ** 32
 
 
 class WrenchJob(NamedTuple):
@@ -60,7 +57,7 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     """An apply_body_wrench request as a job on link ``body`` ("model::link"), checked as gazebo_ros checks it: an
     unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite or
     beyond MAX_WRENCH (the physics would turn the model's state NaN), or a start time or duration that is not
-    finite or beyond MAX_WRENCH_TIME. A start before ``now`` (the sim time) is now, as upstream's. The
+    finite or beyond timed_jobs.MAX_JOB_TIME. A start before ``now`` (the sim time) is now, as upstream's. The
     simulation's ``link_names(model)``, ``link_pose(model, link)`` and ``entity_pose(name)`` (None: no such
     entity) say what exists where."""
     model, _, link = body.partition("::")
@@ -71,10 +68,7 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
         raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
                          f"at most {MAX_WRENCH:g} in size; got {values}")
-    if not all(abs(value) <= MAX_WRENCH_TIME for value in (start, duration)):  # False for NaN too
-        raise ModelError(f"ApplyBodyWrench: body '{body}': start_time and duration must be finite and at most "
-                         f"{MAX_WRENCH_TIME:g} s in size (what a ROS time holds); got start_time {start}, "
-                         f"duration {duration}")
+    check_window(f"ApplyBodyWrench: body '{body}'", start, duration)
     frame_pose = None
     if reference_frame not in WORLD_FRAMES:
         frame_pose = entity_pose(reference_frame)

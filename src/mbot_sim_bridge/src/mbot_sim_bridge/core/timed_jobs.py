@@ -8,8 +8,20 @@ from typing import Callable, Generic, List, Optional, TypeVar
 
 import numpy as np
 
+from .errors import ModelError
+
 # A job: anything with ``start`` and ``duration`` (s of sim time).
 Job = TypeVar("Job")
+# The largest start time and duration (s): what a ROS time or duration can carry (a uint32 or int32 of seconds), so
+# every request through ROS passes, and a start of 1e308 s cannot overflow the loop's count of steps to it.
+MAX_JOB_TIME = 2.0 ** 32
+
+
+def check_window(what: str, start: float, duration: float):
+    """ModelError for a start time or duration that is not finite or beyond MAX_JOB_TIME."""
+    if not all(abs(value) <= MAX_JOB_TIME for value in (start, duration)):  # False for NaN too
+        raise ModelError(f"{what}: start_time and duration must be finite and at most {MAX_JOB_TIME:g} s in size "
+                         f"(what a ROS time holds); got start_time {start}, duration {duration}")
 
 
 def acts_at(job, now: float) -> bool:

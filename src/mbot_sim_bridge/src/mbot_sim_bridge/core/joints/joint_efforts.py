@@ -11,13 +11,11 @@ import math
 from typing import Dict, Iterable, NamedTuple, Optional, Tuple
 
 from ..errors import ModelError
-from ..timed_jobs import TimedJobs
+from ..timed_jobs import TimedJobs, check_window
 
 # apply_joint_effort's largest effort (N·m or N), as apply_body_wrench's largest force: beyond it the physics
 # would turn the model's state NaN.
 MAX_EFFORT = 1e6
-# Its largest start time and duration (s): what a ROS time or duration holds.
-MAX_EFFORT_TIME = 2.0 ** 32
 JOINT_NOT_FOUND = "ApplyJointEffort: joint not found"
 
 
@@ -51,10 +49,7 @@ def requested_job(joint_name: str, effort: float, start: float, duration: float,
     if not (math.isfinite(effort) and abs(effort) <= MAX_EFFORT):
         raise ModelError(f"ApplyJointEffort: joint '{joint_name}': effort must be finite and at most "
                          f"{MAX_EFFORT:g} in size; got {effort}")
-    if not all(abs(value) <= MAX_EFFORT_TIME for value in (start, duration)):  # False for NaN too
-        raise ModelError(f"ApplyJointEffort: joint '{joint_name}': start_time and duration must be finite and at "
-                         f"most {MAX_EFFORT_TIME:g} s in size (what a ROS time holds); got start_time {start}, "
-                         f"duration {duration}")
+    check_window(f"ApplyJointEffort: joint '{joint_name}'", start, duration)
     limit = effort_limit(*found)
     if limit is not None:
         effort = min(max(effort, -limit), limit)
