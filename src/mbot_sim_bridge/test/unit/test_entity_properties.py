@@ -68,6 +68,7 @@ def test_gravity_mode_false_holds_a_crate_up_until_reset(world):
     ("table::plate", {"izz": -0.01}, "the inertia's moments must be above 0"),
     ("table::plate", {"com": Pose((math.inf, 0, 0), IDENTITY.orientation)}, "com must be finite"),
     ("table::plate", {"com": Pose((1e300, 0, 0), IDENTITY.orientation)}, "com must be finite"),
+    ("ground_plane::link", {"mass": 5.0}, "model 'ground_plane' is static"),
 ])
 def test_bad_link_properties_are_refused_and_change_nothing(world, link, change, message):
     sim, table = world

@@ -371,22 +371,28 @@ class Simulation:
         if index is None:
             raise ModelError(f"SetLinkProperties: link '{link_name}': the links of world model '{model}' are welded "
                              "into one body here; only a one-link model's properties can change")
+        if model in self.world_models and self.world_models[model].static:
+            raise ModelError(f"SetLinkProperties: link '{link_name}': model '{model}' is static (it has no mass and "
+                             "does not move); nothing was changed")
         current = self.link_properties(link_name)
         mass, moments, frame_changed = entity_properties.checked_link_properties(link_name, requested, current)
         if frame_changed:
             warn_once(_logger, f"SetLinkProperties: link '{link_name}': Bullet keeps a link's centre of mass and "
                                "inertia axes; the mass and the moments about its axes are set, the rest ignored")
-        client = self.engine.client
         if (model, link) not in self._property_undo:
             weightless = self.engine.weightless(body, index)
 
             def undo():
-                client.changeDynamics(body, index, mass=current.mass, localInertiaDiagonal=(
-                    current.ixx, current.iyy, current.izz))
+                self._set_mass(model, body, index, current.mass, (current.ixx, current.iyy, current.izz))
                 self.engine.set_weightless(body, index, weightless)
             self._property_undo[(model, link)] = undo
-        client.changeDynamics(body, index, mass=mass, localInertiaDiagonal=moments)
+        self._set_mass(model, body, index, mass, moments)
         self.engine.set_weightless(body, index, not requested.gravity_mode)
+
+    def _set_mass(self, model: str, body: int, index: int, mass: float, moments):
+        self.engine.client.changeDynamics(body, index, mass=mass, localInertiaDiagonal=moments)
+        if model in self.models:  # the wheel contact model shares the robot's weight among its wheels
+            self.engine.set_surfaces(self.models[model].robot, self.models[model].robot.driven_joints)
 
     def _joint(self, joint_name: str, not_found: str) -> Tuple[str, str]:
         movable = [(name, spawned.robot.movable_joints) for name, spawned in self.models.items()]
