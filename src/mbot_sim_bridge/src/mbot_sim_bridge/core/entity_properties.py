@@ -9,8 +9,10 @@ link's weight before every step (Bullet has no per-link gravity).
 
 A joint's: its type, damping, position and rate. set_joint_properties takes ODEJointProperties' first entries:
 damping (a torque -damping·rate before every step: PyBullet's own joint damping made a 0.01 kg·m² plate spin at
-its velocity cap), hiStop and loStop (Bullet's joint limits), and fmax with vel (a velocity motor, as ODE's);
-erp, cfm, stop_erp, stop_cfm and fudge_factor have no Bullet counterpart and are warned about once.
+its velocity cap), hiStop and loStop (Bullet's joint limits; a joint already beyond a new stop is held where it
+is, not pushed back), and fmax with vel (a velocity motor, as ODE's; it stays until a plugin or reset_simulation
+sets the joint's motor again); erp, cfm, stop_erp, stop_cfm and fudge_factor have no Bullet counterpart and are
+warned about once.
 """
 import math
 from typing import List, NamedTuple, Optional, Sequence
