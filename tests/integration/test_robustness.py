@@ -321,8 +321,9 @@ def test_fifo_world_is_refused_and_the_bridge_stops(ros_env, tmp_path):
 # -- a sample of the fuzzing through ROS: garbage requests get success false, and the bridge carries on ----------
 GARBAGE_CALLS = [
     ("set_model_state", "{model_state: {model_name: nowhere}}", "does not exist"),
-    ("set_model_state", "{model_state: {model_name: good, reference_frame: nowhere}}", "nowhere"),
-    ("get_model_state", "{model_name: nowhere}", "nowhere"),
+    ("set_model_state", "{model_state: {model_name: good, reference_frame: nowhere}}",
+     "SetModelState: specified reference frame entity does not exist"),  # upstream's messages
+    ("get_model_state", "{model_name: nowhere}", "GetModelState: model does not exist"),
     ("delete_model", "{model_name: nowhere}", "does not exist"),
     ("spawn_urdf_model", "{model_name: junk, model_xml: '<robot'}", "not valid XML"),
     ("spawn_urdf_model", "{model_name: junk, model_xml: '<robot name=\"r\"/>'}", "has no <link>"),

@@ -17,6 +17,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
+from gazebo_services import GazeboServices  # noqa: F401 (run by rosrun below, in this world)
 from sim_support import Simulator, wait_for
 
 
@@ -134,4 +135,4 @@ class RosApi(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "ros_api", RosApi)
+    rostest.rosrun("mbot_tests", "ros_api", "__main__")  # RosApi and GazeboServices

@@ -79,13 +79,11 @@ class SimBridgeNode:
                               RosParameters(), resolve_package_uris)
         self.sim.paused = paused or lockstep
         physics = world.physics
-        self.step_size = physics.max_step_size
-        self.real_time_factor = (float(real_time_factor) if real_time_factor
-                                 else physics.max_step_size * physics.real_time_update_rate)
+        self._real_time_factor_param = float(real_time_factor) if real_time_factor else None
+        self.physics_changed()
 
         self.clock_publisher = loop_publisher("/clock", Clock)
         self.clock_timer = UpdateTimer(clock_frequency)
-        self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
         self._requests: "queue.Queue[tuple]" = queue.Queue()
         self.steps_left = 0  # of the step_simulation under way
         self._stop = threading.Event()  # set by run(): a stop asked for while a step request runs
@@ -174,6 +172,8 @@ class SimBridgeNode:
         if self._sets_rospy_time:
             rospy.rostime._set_rostime(stamp)
         self.api.model_states.publish()
+        self.api.link_states.publish()
+        self.api.performance_metrics.publish()
         # The timer guarantees the longest gap between two /clock messages, counted from the last one.
         self.clock_timer.reset(now)
         self._last_clock = now
@@ -193,6 +193,16 @@ class SimBridgeNode:
                 function, future = self._requests.get_nowait()
             except queue.Empty:
                 return
+
+    def physics_changed(self):
+        """The step size and pacing from the simulation's physics (at start and after set_physics_properties): the
+        real-time factor is step × update rate, as Gazebo's, unless ~real_time_factor sets it."""
+        physics = self.sim.engine.physics
+        self.step_size = physics.max_step_size
+        self.real_time_factor = (self._real_time_factor_param if self._real_time_factor_param is not None
+                                 else physics.max_step_size * physics.real_time_update_rate)
+        self._batch_steps = max(1, int(round(MAX_BATCH_SIM_SECONDS / self.step_size)))
+        self._restart_pacing()
 
     def _restart_pacing(self):
         self._pace_wall_start = time.monotonic()

@@ -16,25 +16,40 @@ from gazebo_msgs.srv import (ApplyBodyWrench, ApplyBodyWrenchResponse, BodyReque
                              SpawnModelResponse)
 from gazebo_msgs.srv import (GetLinkState, GetLinkStateResponse, GetModelProperties, GetModelPropertiesResponse,
                              SetModelConfiguration, SetModelConfigurationResponse)
+from gazebo_msgs.srv import ApplyJointEffort, ApplyJointEffortResponse, JointRequest, JointRequestResponse
+from gazebo_msgs.srv import SetLinkState, SetLinkStateResponse
+from gazebo_msgs.srv import (GetJointProperties, GetJointPropertiesResponse, GetLinkProperties,
+                             GetLinkPropertiesResponse, SetJointProperties, SetJointPropertiesResponse,
+                             SetLinkProperties, SetLinkPropertiesResponse)
+from gazebo_msgs.msg import LinkState, ModelState, ODEPhysics
+from gazebo_msgs.srv import SetPhysicsProperties, SetPhysicsPropertiesResponse
+from gazebo_msgs.srv import (DeleteLight, DeleteLightResponse, GetLightProperties, GetLightPropertiesResponse,
+                             SetLightProperties, SetLightPropertiesResponse)
+from std_msgs.msg import ColorRGBA
 from geometry_msgs.msg import Pose as PoseMessage
 from mbot_sim_msgs.srv import SaveWorld, StepSimulation, StepSimulationResponse
 from geometry_msgs.msg import Twist
 from std_srvs.srv import Empty, EmptyResponse
 
 from .core.engine import check_model_name, check_state
+from .core.entity_properties import LinkProperties
+from .core.physics_properties import OdeConfig
 from .core.errors import BridgeError, ModelError
-from .core.geometry import IDENTITY, Pose, compose, inverse, rotate
+from .core.geometry import Pose, compose, rotate
 from .gazebo_paths import model_path
 from .core.description.robot_model import parse_robot
 from .core.description.sdf_spawn import spawn_world_xml
 from .core.description.sdf_world import parse_world
-from .model_states import ModelStatesPublisher
+from .model_states import LinkStatesPublisher, ModelStatesPublisher
 from .package_uris import resolve_package_uris
+from .performance_metrics import PerformanceMetricsPublisher
+from .physics_reconfigure import PhysicsReconfigure
 from .plugins import ros_time
 from .subscriptions import drain
 from .world_saving import SaveWorldHandler
 
-_WORLD_FRAMES = ("", "world", "map", "/map")
+SPAWN_FRAME_NOT_FOUND = ("SpawnModel: reference reference_frame not found, did you forget to scope the link by model "
+                         "name?")
 # How long a step request waits for the bridge's subscribers to handle what reached them.
 LOCKSTEP_DRAIN_SECONDS = 5.0
 # One step_simulation call covers at most this much sim time: the largest uint32 count would hold the
@@ -64,6 +79,14 @@ def _pose_to_message(pose: Pose) -> PoseMessage:
     return message
 
 
+def _colour(colour: ColorRGBA):
+    return colour.r, colour.g, colour.b, colour.a
+
+
+def _twist_vectors(twist: Twist):
+    return ((twist.linear.x, twist.linear.y, twist.linear.z), (twist.angular.x, twist.angular.y, twist.angular.z))
+
+
 def _twist_message(linear, angular) -> Twist:
     twist = Twist()
     twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
@@ -76,6 +99,16 @@ class GazeboRosApi:
         self.node = node
         self.sim = node.sim
         self.model_states = ModelStatesPublisher(self.sim)
+        self.link_states = LinkStatesPublisher(self.sim)
+        self.performance_metrics = PerformanceMetricsPublisher(self.sim)
+        self.physics_reconfigure = PhysicsReconfigure(node)
+        # As upstream's: the topics take the services' requests, and a refused one is only logged.
+        self._subscribers = [
+            rospy.Subscriber("~set_model_state", ModelState, lambda state: self._set_model_state(
+                SetModelState._request_class(model_state=state))),
+            rospy.Subscriber("~set_link_state", LinkState, lambda state: self._set_link_state(
+                SetLinkState._request_class(link_state=state))),
+        ]
         self._services = [
             rospy.Service("~spawn_urdf_model", SpawnModel, self._spawn_urdf_model),
             rospy.Service("~spawn_sdf_model", SpawnModel, self._spawn_sdf_model),
@@ -84,6 +117,7 @@ class GazeboRosApi:
             rospy.Service("~set_model_state", SetModelState, self._set_model_state),
             rospy.Service("~get_world_properties", GetWorldProperties, self._get_world_properties),
             rospy.Service("~get_physics_properties", GetPhysicsProperties, self._get_physics_properties),
+            rospy.Service("~set_physics_properties", SetPhysicsProperties, self._set_physics_properties),
             rospy.Service("~pause_physics", Empty, self._empty(lambda: node.set_paused(True))),
             rospy.Service("~unpause_physics", Empty, self._empty(lambda: node.set_paused(False))),
             rospy.Service("~reset_simulation", Empty, self._empty(lambda: node.reset(simulation=True))),
@@ -94,6 +128,16 @@ class GazeboRosApi:
             rospy.Service("~set_model_configuration", SetModelConfiguration, self._set_model_configuration),
             rospy.Service("~get_model_properties", GetModelProperties, self._get_model_properties),
             rospy.Service("~get_link_state", GetLinkState, self._get_link_state),
+            rospy.Service("~apply_joint_effort", ApplyJointEffort, self._apply_joint_effort),
+            rospy.Service("~clear_joint_forces", JointRequest, self._clear_joint_forces),
+            rospy.Service("~set_link_state", SetLinkState, self._set_link_state),
+            rospy.Service("~get_joint_properties", GetJointProperties, self._get_joint_properties),
+            rospy.Service("~set_joint_properties", SetJointProperties, self._set_joint_properties),
+            rospy.Service("~get_link_properties", GetLinkProperties, self._get_link_properties),
+            rospy.Service("~set_link_properties", SetLinkProperties, self._set_link_properties),
+            rospy.Service("~get_light_properties", GetLightProperties, self._get_light_properties),
+            rospy.Service("~set_light_properties", SetLightProperties, self._set_light_properties),
+            rospy.Service("~delete_light", DeleteLight, self._delete_light),
             # The bridge's own; the loaded world's description is read again for its lights, scene and name.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
@@ -120,7 +164,7 @@ class GazeboRosApi:
         requested = _pose_from_message(request.initial_pose)
         # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
         check_state(f"SpawnModel: model '{request.model_name}'", requested)
-        pose = compose(self._reference_pose(request.reference_frame), requested)
+        pose = compose(self.sim.reference_pose(request.reference_frame, SPAWN_FRAME_NOT_FOUND), requested)
         check_state(f"SpawnModel: model '{request.model_name}'", pose)
         return pose
 
@@ -189,20 +233,9 @@ class GazeboRosApi:
         return self._guarded(StepSimulationResponse, step, timeout=None)
 
     # -- state queries ---------------------------------------------------------------------------------------
-    def _reference_pose(self, frame: str) -> Pose:
-        if frame in _WORLD_FRAMES:
-            return IDENTITY
-        if frame in self.sim.model_names():
-            return self.sim.engine.model_pose(frame)
-        raise ModelError(f"reference frame '{frame}' is neither the world nor a model")
-
     def _get_model_state(self, request):
         def get():
-            engine = self.sim.engine
-            reference = inverse(self._reference_pose(request.relative_entity_name))
-            pose = compose(reference, engine.model_pose(request.model_name))
-            linear, angular = engine.model_velocity(request.model_name)
-            linear, angular = rotate(reference.orientation, linear), rotate(reference.orientation, angular)
+            pose, linear, angular = self.sim.model_state(request.model_name, request.relative_entity_name)
             response = GetModelStateResponse(pose=_pose_to_message(pose), twist=_twist_message(linear, angular),
                                              success=True, status_message="GetModelState: got properties")
             response.header.stamp = ros_time(self.sim.sim_time)
@@ -214,10 +247,11 @@ class GazeboRosApi:
         state = request.model_state
 
         def set_state():
-            reference = self._reference_pose(state.reference_frame)
-            requested, twist = _pose_from_message(state.pose), state.twist
-            linear, angular = ((twist.linear.x, twist.linear.y, twist.linear.z),
-                               (twist.angular.x, twist.angular.y, twist.angular.z))
+            if state.model_name not in self.sim.model_names():
+                raise ModelError("SetModelState: model does not exist")
+            reference = self.sim.reference_pose(state.reference_frame,
+                                                 "SetModelState: specified reference frame entity does not exist")
+            requested, (linear, angular) = _pose_from_message(state.pose), _twist_vectors(state.twist)
             # Checked as sent too: transformed, 1e300 would turn inf and NaN, and on other axes.
             check_state(f"SetModelState: model '{state.model_name}'", requested, linear, angular)
             pose = compose(reference, requested)
@@ -225,6 +259,15 @@ class GazeboRosApi:
             self.sim.set_model_state(state.model_name, pose, linear, angular)
             return SetModelStateResponse(success=True, status_message="SetModelState: set model state done")
         return self._guarded(SetModelStateResponse, set_state)
+
+    def _set_link_state(self, request):
+        state = request.link_state
+
+        def set_state():
+            self.sim.set_link_state(state.link_name, state.reference_frame, _pose_from_message(state.pose),
+                                    *_twist_vectors(state.twist))
+            return SetLinkStateResponse(success=True, status_message="SetLinkState: success")
+        return self._guarded(SetLinkStateResponse, set_state)
 
     # -- wrenches ----------------------------------------------------------------------------------------------
     def _apply_body_wrench(self, request):
@@ -245,7 +288,8 @@ class GazeboRosApi:
     def _get_world_properties(self, _request):
         def get():
             return GetWorldPropertiesResponse(sim_time=self.sim.sim_time, model_names=self.sim.model_names(),
-                                              rendering_enabled=True, success=True, status_message="")
+                                              rendering_enabled=True, success=True,
+                                              status_message="GetWorldProperties: got properties")
         return self._guarded(GetWorldPropertiesResponse, get)
 
     def _get_physics_properties(self, _request):
@@ -253,15 +297,33 @@ class GazeboRosApi:
             physics = self.sim.engine.physics
             response = GetPhysicsPropertiesResponse(time_step=physics.max_step_size, pause=self.sim.paused,
                                                     max_update_rate=physics.real_time_update_rate,
-                                                    success=True, status_message="")
+                                                    ode_config=ODEPhysics(**self.sim.ode_config()._asdict()),
+                                                    success=True, status_message="GetPhysicsProperties: got properties")
             response.gravity.x, response.gravity.y, response.gravity.z = physics.gravity
-            ode = response.ode_config
-            ode.erp, ode.contact_max_correcting_vel = physics.erp, physics.contact_max_correcting_vel
-            ode.contact_surface_layer = physics.contact_surface_layer
             return response
         return self._guarded(GetPhysicsPropertiesResponse, get)
 
+    def _set_physics_properties(self, request):
+        def set_physics():
+            gravity = (request.gravity.x, request.gravity.y, request.gravity.z)
+            ode = OdeConfig(**{field: getattr(request.ode_config, field) for field in OdeConfig._fields})
+            self.sim.set_physics(request.time_step, request.max_update_rate, gravity, ode)
+            self.node.physics_changed()
+            return SetPhysicsPropertiesResponse(success=True, status_message="physics engine updated")
+        return self._guarded(SetPhysicsPropertiesResponse, set_physics)
+
     # -- joints --------------------------------------------------------------------------------------------------
+    def _apply_joint_effort(self, request):
+        def apply():
+            self.sim.apply_joint_effort(request.joint_name, request.effort, request.start_time.to_sec(),
+                                        request.duration.to_sec())
+            return ApplyJointEffortResponse(success=True, status_message="ApplyJointEffort: effort set")
+        return self._guarded(ApplyJointEffortResponse, apply)
+
+    def _clear_joint_forces(self, request):
+        self.node.call_in_loop(lambda: self.sim.joint_efforts.clear_named(request.joint_name))
+        return JointRequestResponse()
+
     def _set_model_configuration(self, request):
         def set_configuration():
             missing = self.sim.set_model_configuration(request.model_name, request.joint_names,
@@ -292,6 +354,64 @@ class GazeboRosApi:
             state.pose, state.twist = _pose_to_message(pose), _twist_message(linear, angular)
             return response
         return self._guarded(GetLinkStateResponse, get)
+
+
+    # -- link and joint properties ---------------------------------------------------------------------------------
+    def _get_joint_properties(self, request):
+        def get():
+            properties = self.sim.joint_properties(request.joint_name)
+            return GetJointPropertiesResponse(**properties._asdict(), success=True,
+                                              status_message="GetJointProperties: got properties")
+        return self._guarded(GetJointPropertiesResponse, get)
+
+    def _set_joint_properties(self, request):
+        def set_properties():
+            self.sim.set_joint_properties(request.joint_name, request.ode_joint_config)
+            return SetJointPropertiesResponse(success=True, status_message="SetJointProperties: properties set")
+        return self._guarded(SetJointPropertiesResponse, set_properties)
+
+    def _get_link_properties(self, request):
+        def get():
+            properties = self.sim.link_properties(request.link_name)
+            return GetLinkPropertiesResponse(**properties._replace(com=_pose_to_message(properties.com))._asdict(),
+                                             success=True, status_message="GetLinkProperties: got properties")
+        return self._guarded(GetLinkPropertiesResponse, get)
+
+    def _set_link_properties(self, request):
+        def set_properties():
+            fields = {field: getattr(request, field) for field in LinkProperties._fields}
+            self.sim.set_link_properties(request.link_name, LinkProperties(**{
+                **fields, "com": _pose_from_message(request.com)}))
+            return SetLinkPropertiesResponse(success=True, status_message="SetLinkProperties: properties set")
+        return self._guarded(SetLinkPropertiesResponse, set_properties)
+
+    # -- lights (kept, not rendered: core/lights.py) -------------------------------------------------------------------
+    def _get_light_properties(self, request):
+        def get():
+            light = self.sim.lights.get(request.light_name)
+            constant, linear, quadratic = light.attenuation
+            # Upstream answers success with no status message.
+            return GetLightPropertiesResponse(diffuse=ColorRGBA(*light.diffuse), attenuation_constant=constant,
+                                              attenuation_linear=linear, attenuation_quadratic=quadratic,
+                                              success=True)
+        return self._guarded(GetLightPropertiesResponse, get)
+
+    def _set_light_properties(self, request):
+        def set_properties():
+            direction = request.direction
+            self.sim.lights.set(request.light_name, request.cast_shadows, _colour(request.diffuse),
+                                _colour(request.specular), (request.attenuation_constant, request.attenuation_linear,
+                                                           request.attenuation_quadratic),
+                                (direction.x, direction.y, direction.z), _pose_from_message(request.pose))
+            return SetLightPropertiesResponse(success=True)
+        return self._guarded(SetLightPropertiesResponse, set_properties)
+
+    def _delete_light(self, request):
+        def delete():
+            self.sim.lights.delete(request.light_name)
+            return DeleteLightResponse(success=True,
+                                       status_message=f"DeleteLight: {request.light_name} successfully deleted")
+        return self._guarded(DeleteLightResponse, delete)
 
 
 def _refused(response_type, error: BridgeError):

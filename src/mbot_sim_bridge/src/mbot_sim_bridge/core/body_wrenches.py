@@ -14,22 +14,18 @@ force. The result is applied in the world frame, so a wrench given in the link's
 axes (upstream's "FIXME map is really wrong").
 """
 import math
-import sys
-import threading
 from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .errors import ModelError
 from .geometry import Pose, Vector, inverse, compose, rotate
+from .timed_jobs import TimedJobs, check_window
 
 ZERO = (0.0, 0.0, 0.0)
 WORLD_FRAMES = ("", "world", "map", "/map")
 # apply_body_wrench's largest force (N), torque (N·m) and reference point coordinate (m).
 MAX_WRENCH = 1e6
-# Its largest start time and duration (s): what a ROS time or duration can carry (a uint32 or int32 of seconds),
-# so every request through ROS passes, and a start of 1e308 s cannot overflow the loop's count of steps to it.
-MAX_WRENCH_TIME = 2.0 ** 32
 
 
 class WrenchJob(NamedTuple):
@@ -39,12 +35,6 @@ class WrenchJob(NamedTuple):
     torque: Vector
     start: float
     duration: float
-
-    def acts_at(self, now: float) -> bool:
-        return now >= self.start and (self.duration < 0 or now <= self.start + self.duration)
-
-    def ended_at(self, now: float) -> bool:
-        return self.duration >= 0 and now > self.start + self.duration
 
 
 def target_wrench(force: Sequence[float], torque: Sequence[float], reference_point: Sequence[float],
@@ -67,7 +57,7 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     """An apply_body_wrench request as a job on link ``body`` ("model::link"), checked as gazebo_ros checks it: an
     unknown body or frame raises ModelError with upstream's message, and so does a value that is not finite or
     beyond MAX_WRENCH (the physics would turn the model's state NaN), or a start time or duration that is not
-    finite or beyond MAX_WRENCH_TIME. A start before ``now`` (the sim time) is now, as upstream's. The
+    finite or beyond timed_jobs.MAX_JOB_TIME. A start before ``now`` (the sim time) is now, as upstream's. The
     simulation's ``link_names(model)``, ``link_pose(model, link)`` and ``entity_pose(name)`` (None: no such
     entity) say what exists where."""
     model, _, link = body.partition("::")
@@ -78,10 +68,7 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     if not all(math.isfinite(value) and abs(value) <= MAX_WRENCH for value in values):
         raise ModelError(f"ApplyBodyWrench: body '{body}': reference point, force and torque must be finite and "
                          f"at most {MAX_WRENCH:g} in size; got {values}")
-    if not all(abs(value) <= MAX_WRENCH_TIME for value in (start, duration)):  # False for NaN too
-        raise ModelError(f"ApplyBodyWrench: body '{body}': start_time and duration must be finite and at most "
-                         f"{MAX_WRENCH_TIME:g} s in size (what a ROS time holds); got start_time {start}, "
-                         f"duration {duration}")
+    check_window(f"ApplyBodyWrench: body '{body}'", start, duration)
     frame_pose = None
     if reference_frame not in WORLD_FRAMES:
         frame_pose = entity_pose(reference_frame)
@@ -91,47 +78,22 @@ def requested_job(body: str, reference_frame: str, reference_point: Sequence[flo
     return WrenchJob(model, link, force, torque, max(start, now), duration)
 
 
-class BodyWrenches:
-    """The scheduled jobs; requests arrive from ROS threads, the loop applies them."""
+class BodyWrenches(TimedJobs[WrenchJob]):
+    """apply_body_wrench's jobs, and what they applied in the last step."""
 
     def __init__(self):
-        self._lock = threading.Lock()
-        self._jobs: List[WrenchJob] = []
+        super().__init__()
         self.applied: Dict[Tuple[str, str], Tuple[Vector, Vector]] = {}
-
-    def add(self, job: WrenchJob):
-        with self._lock:
-            self._jobs.append(job)
 
     def clear(self, model: str, link: Optional[str] = None):
         """Drop the jobs of one link, or of every link of ``model`` (its deletion)."""
-        with self._lock:
-            self._jobs = [job for job in self._jobs if not (job.model == model and link in (None, job.link))]
-
-    def pending(self) -> bool:
-        return bool(self._jobs)
-
-    def steps_until_next(self, now: float, step_size: float) -> Optional[int]:
-        """1 while a job acts; the steps to the earliest start otherwise; None without jobs."""
-        with self._lock:
-            starts = [job.start for job in self._jobs]
-        if not starts:
-            return None
-        steps = (min(starts) - now) / step_size - 1e-9
-        if not steps < sys.maxsize:  # a start too far off to count in steps (1e308 s overflowed): not due
-            return sys.maxsize
-        return max(1, int(np.ceil(steps)))
+        self.remove(lambda job: job.model == model and link in (None, job.link))
 
     def due(self, now: float) -> Dict[Tuple[str, str], Tuple[Vector, Vector]]:
-        """(model, link) -> (force, torque) to apply in the step starting at ``now``; ended jobs are dropped."""
-        with self._lock:
-            acting = {}
-            for job in self._jobs:
-                if job.acts_at(now):
-                    acting[(job.model, job.link)] = (job.force, job.torque)
-            self._jobs = [job for job in self._jobs if not job.ended_at(now)]
-        self.applied = acting
-        return acting
+        """(model, link) -> (force, torque) to apply in the step starting at ``now``: of several jobs on one link
+        the last one wins (Gazebo's SetForce and SetTorque)."""
+        self.applied = {(job.model, job.link): (job.force, job.torque) for job in self.acting(now)}
+        return self.applied
 
     def applied_to(self, model: str, link: str) -> Tuple[Vector, Vector]:
         return self.applied.get((model, link), (ZERO, ZERO))

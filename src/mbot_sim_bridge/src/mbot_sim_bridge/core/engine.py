@@ -47,6 +47,8 @@ PENETRATION_TOLERANCE = 1.0e-5  # m
 # A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
 # stay finite below it.
 MAX_WHEEL_MU = 1.0e3
+# PyBullet's own number of solver iterations (ODE's <iters> default is the same).
+DEFAULT_SOLVER_ITERATIONS = 50
 # PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
 # every query fails ("GetBasePositionAndOrientation failed").
 MAX_BODY_LINKS = 128
@@ -288,8 +290,11 @@ class Engine:
     def __init__(self, physics: PhysicsConfig = PhysicsConfig(), connection_mode: int = pybullet.DIRECT):
         self.client = CachingBulletClient(connection_mode=connection_mode)
         self.physics = physics
+        self.solver_iterations = DEFAULT_SOLVER_ITERATIONS  # ODE's <iters>, set_physics_properties' sor_pgs_iters
         self._configure()
         self.steps = 0
+        # Sim time at step 0 of the current step size: set_physics_properties changes the step size mid-run.
+        self.time_offset = 0.0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
@@ -303,6 +308,10 @@ class Engine:
         self._settling: Dict[int, List[int]] = {}
         self._wheels: Dict[int, WheelContacts] = {}  # per body, the friction of its wheels (wheel_contact)
         self._before_step: List[Callable[[], None]] = []
+        # set_joint_properties' damping: body -> joint index -> N·m·s/rad; set_link_properties' gravity_mode
+        # false: body -> link indices.
+        self._joint_damping: Dict[int, Dict[int, float]] = {}
+        self._weightless: Dict[int, set] = {}
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -316,7 +325,8 @@ class Engine:
         # PyBullet's). Contacts keep PyBullet's contactERP (0.08), as ODE's take theirs from the surfaces' kp and
         # kd, and PyBullet's slop: ODE's 1 mm surface layer as the slop sank every robot and gripper finger 1 mm
         # into what it touches and moved the skid-steer turn figures by 1 %.
-        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp)
+        self.client.setPhysicsEngineParameter(contactSlop=CONTACT_SLOP, contactERP=CONTACT_ERP, erp=self.physics.erp,
+                                              numSolverIterations=self.solver_iterations)
 
     def restart(self):
         """An empty world at sim time 0, as a fresh Engine; the caller builds the models again.
@@ -327,6 +337,7 @@ class Engine:
         self.client.resetSimulation()
         self._configure()
         self.steps = 0
+        self.time_offset = 0.0
         self.robots.clear()
         self.world_bodies.clear()
         self.dynamic_world_bodies.clear()
@@ -335,11 +346,21 @@ class Engine:
         self._root_from_com.clear()
         self._settling.clear()
         self._wheels.clear()
+        self._joint_damping.clear()
+        self._weightless.clear()
         self._before_step = []
 
     @property
     def sim_time(self) -> float:
-        return self.steps * self.physics.max_step_size
+        return self.time_offset + self.steps * self.physics.max_step_size
+
+    def set_physics(self, physics: PhysicsConfig, solver_iterations: int):
+        """New physics settings between two steps (set_physics_properties); sim time goes on from where it is."""
+        self.time_offset = self.sim_time - self.steps * physics.max_step_size
+        self.physics, self.solver_iterations = physics, solver_iterations
+        self._configure()
+        for robot in self.robots.values():  # the wheel contact model is made for one step size
+            self.set_surfaces(robot, robot.driven_joints)
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
         """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of
@@ -440,6 +461,9 @@ class Engine:
         self._settling.pop(body, None)
         self.collision_names.pop(body, None)
         self._set_wheels(body, None)
+        self._joint_damping.pop(body, None)
+        self._weightless.pop(body, None)
+        self._refresh_before_step()
         self.client.removeBody(body)
 
     def body_of(self, name: str) -> int:
@@ -473,6 +497,20 @@ class Engine:
         com = compose(pose, inverse(self._root_from_com[body]))
         self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
         self.client.resetBaseVelocity(body, linear, angular)
+        self._settle(body)
+
+    def move_model(self, name: str, pose: Pose, point, linear, angular, stop_joints: bool):
+        """Move a model's frame to ``pose``, as one rigid body turning at ``angular`` whose ``point`` (world, after
+        the move) has velocity ``linear``; ``stop_joints``: its joints' velocities become 0 (set_link_state)."""
+        body = self.body_of(name)
+        com = compose(pose, inverse(self._root_from_com[body]))
+        self.client.resetBasePositionAndOrientation(body, com.position, com.orientation)
+        com_linear = np.add(linear, np.cross(angular, np.subtract(com.position, point)))
+        self.client.resetBaseVelocity(body, com_linear.tolist(), list(angular))
+        if stop_joints:
+            for index, (position, *_) in enumerate(self.client.getJointStates(
+                    body, range(self.client.getNumJoints(body))) or ()):
+                self.client.resetJointState(body, index, position, 0.0)
         self._settle(body)
 
     def set_joint_positions(self, robot: SpawnedRobot, positions: Dict[str, float]):
@@ -666,7 +704,54 @@ class Engine:
             self._wheels.pop(body, None)
         else:
             self._wheels[body] = contacts
+        self._refresh_before_step()
+
+    def _refresh_before_step(self):
         self._before_step = [wheels.apply for wheels in self._wheels.values()]
+        if self._joint_damping:
+            self._before_step.append(self._damp_joints)
+        if self._weightless:
+            self._before_step.append(self._cancel_weights)
+
+    # -- link and joint properties set from outside (entity_properties) ------------------------------------------
+    def set_joint_damping(self, body: int, index: int, damping: float):
+        """A torque of -damping times the joint's rate before every step (0: none)."""
+        joints = self._joint_damping.setdefault(body, {})
+        joints[index] = damping
+        if not damping:
+            del joints[index]
+        if not joints:
+            del self._joint_damping[body]
+        self._refresh_before_step()
+
+    def joint_damping(self, body: int, index: int) -> float:
+        return self._joint_damping.get(body, {}).get(index, 0.0)
+
+    def set_weightless(self, body: int, index: int, weightless: bool):
+        """Whether a force cancels the link's weight before every step (Gazebo's gravity_mode false)."""
+        links = self._weightless.setdefault(body, set())
+        (links.add if weightless else links.discard)(index)
+        if not links:
+            del self._weightless[body]
+        self._refresh_before_step()
+
+    def weightless(self, body: int, index: int) -> bool:
+        return index in self._weightless.get(body, ())
+
+    def _damp_joints(self):
+        client = self.client
+        for body, joints in self._joint_damping.items():
+            for index, (_, rate, *_) in zip(joints, client.getJointStates(body, list(joints))):
+                client.setJointMotorControl2(body, index, pybullet.TORQUE_CONTROL, force=-joints[index] * rate)
+
+    def _cancel_weights(self):
+        client, gravity = self.client, self.physics.gravity
+        for body, links in self._weightless.items():
+            for index in links:
+                mass = client.getDynamicsInfo(body, index)[0]
+                centre = (client.getBasePositionAndOrientation(body)[0] if index == -1
+                          else client.getLinkState(body, index)[0])
+                client.applyExternalForce(body, index, [-mass * g for g in gravity], centre, pybullet.WORLD_FRAME)
 
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, modelled: bool):
         mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")

@@ -17,10 +17,15 @@ import pybullet
 
 from .added_plugins import joint_state_blocks, mimic_blocks
 from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
-from .engine import Engine, frame_velocity
+from .engine import Engine, check_state, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
+from . import entity_properties, physics_properties
+from .entity_properties import JointProperties, LinkProperties
+from .joints import joint_efforts
+from .joints.joint_efforts import JointEfforts
 from .joints.model_configuration import requested_positions
+from .lights import Lights, world_lights
 from .log import get_logger, warn_once
 from .parameters import Parameters
 from .plugin import Plugin, PluginContext, SpawnedModel
@@ -79,6 +84,12 @@ class Simulation:
         self._frozen: Set[str] = set()  # models the physics turned NaN, held until a reset
         self._render_scene: Optional[RenderScene] = None
         self.wrenches = BodyWrenches()  # apply_body_wrench's jobs
+        self.joint_efforts = JointEfforts()  # apply_joint_effort's
+        # How to undo each link's and joint's properties set from outside, for reset_world: (model, name) -> undo.
+        self._property_undo: Dict[Tuple[str, str], Callable[[], None]] = {}
+        self._joint_limits: Dict[Tuple[str, str], Tuple[float, float]] = {}  # set by set_joint_properties
+        self.lights = Lights(world_lights(world.others))
+        self.sensor_updates: Dict[Plugin, int] = {}  # updates of each sensor plugin so far (performance_metrics)
         self.add_world(world)
 
     # -- state -------------------------------------------------------------------------------------------------
@@ -156,6 +167,7 @@ class Simulation:
         if spawned is not None:
             for plugin in spawned.plugins:
                 plugin.close()
+                self.sensor_updates.pop(plugin, None)
             if self.viewer is not None:
                 self.viewer.forget_robot(spawned.robot)
             for key in [key for key in self._streams if key.startswith(name + "/")]:
@@ -165,6 +177,10 @@ class Simulation:
             self._schedule()
         self.world_models.pop(name, None)
         self.wrenches.clear(name)
+        self.joint_efforts.clear(name)
+        for key in [key for key in self._property_undo if key[0] == name]:
+            del self._property_undo[key]
+        self._joint_limits = {key: value for key, value in self._joint_limits.items() if key[0] != name}
         self.engine.remove(name)
         self.version += 1
 
@@ -179,6 +195,23 @@ class Simulation:
     def clear_body_wrenches(self, body: str):
         model, _, link = body.partition("::")
         self.wrenches.clear(model, link)
+
+    # -- efforts on joints from outside (apply_joint_effort) ---------------------------------------------------------
+    def apply_joint_effort(self, joint_name: str, effort: float, start_time: float, duration: float):
+        """Schedule an effort on a robot's joint ("joint" or "model::joint"), as gazebo_ros's apply_joint_effort
+        (see ``joints.joint_efforts``; ModelError with upstream's message)."""
+        movable = [(name, spawned.robot.movable_joints) for name, spawned in self.models.items()]
+        self.joint_efforts.add(joint_efforts.requested_job(joint_name, effort, start_time, duration, self.sim_time,
+                                                           movable, self._effort_limit))
+
+    def _effort_limit(self, model: str, joint: str) -> Optional[float]:
+        described = self.models[model].robot.model.joints[joint]
+        return described.effort if described.has_limit and described.effort > 0 else None
+
+    def _apply_joint_efforts(self):
+        for (model, joint), effort in self.joint_efforts.due(self.sim_time).items():
+            if model not in self._frozen:
+                self.models[model].robot.set_joint_effort(joint, effort)
 
     def link_names(self, model: str) -> List[str]:
         """The links a model has in the physics (a robot's after lumping, a world model's own)."""
@@ -214,21 +247,198 @@ class Simulation:
 
     def link_state(self, link_name: str, reference_frame: str) -> Tuple[Pose, Vector, Vector]:
         """get_link_state: a "model::link"'s pose and (linear, angular) velocity relative to any entity, as
-        gazebo_ros computes them (the velocities are the differences with the frame's, rotated into it)."""
+        gazebo_ros computes them (``_relative``)."""
         model, _, link = link_name.partition("::")
         if not link or link not in self.link_names(model):
             raise ModelError("GetLinkState: link not found, did you forget to scope the link by model name?")
-        pose, (linear, angular) = self._link_pose(model, link), self._entity_twist(link_name)
-        frame = self._entity_pose(reference_frame)
+        return self._relative(reference_frame, self._link_pose(model, link), *self._entity_twist(link_name),
+                              "GetLinkState: reference reference_frame not found, did you forget to scope the link "
+                              "by model name?")
+
+    def model_state(self, name: str, relative_entity_name: str) -> Tuple[Pose, Vector, Vector]:
+        """get_model_state: a model's pose and (linear, angular) velocity relative to any entity (``_relative``)."""
+        if name not in self.model_names():
+            raise ModelError("GetModelState: model does not exist")
+        return self._relative(relative_entity_name, self.engine.model_pose(name), *self.engine.model_velocity(name),
+                              "GetModelState: reference relative_entity_name not found, did you forget to scope the "
+                              "body by model name?")
+
+    def _relative(self, frame_name: str, pose: Pose, linear, angular, not_found: str) -> Tuple[Pose, Vector, Vector]:
+        """A world state seen from entity ``frame_name`` as gazebo_ros's get_*_state compute it: the pose relative
+        to the frame, the velocities the differences with the frame's, rotated into it (no ω × r term, so a point
+        at rest in a turning frame has no velocity in it). A world frame keeps them; another unknown name raises
+        ModelError(``not_found``)."""
+        frame = self._entity_pose(frame_name)
         if frame is None:
-            if reference_frame in WORLD_FRAMES:
+            if frame_name in WORLD_FRAMES:
                 return pose, tuple(linear), tuple(angular)
-            raise ModelError("GetLinkState: reference reference_frame not found, did you forget to scope the link by "
-                             "model name?")
-        frame_linear, frame_angular = self._entity_twist(reference_frame)
+            raise ModelError(not_found)
+        frame_linear, frame_angular = self._entity_twist(frame_name)
         back = inverse(frame)
         return (compose(back, pose), rotate(back.orientation, np.subtract(linear, frame_linear)),
                 rotate(back.orientation, np.subtract(angular, frame_angular)))
+
+    def reference_pose(self, frame_name: str, not_found: str) -> Pose:
+        """The world pose of a request's reference frame: any model or "model::link", the world for "", "world",
+        "map" and "/map"; ModelError(``not_found``) for another name."""
+        frame = self._entity_pose(frame_name)
+        if frame is None:
+            if frame_name in WORLD_FRAMES:
+                return IDENTITY
+            raise ModelError(not_found)
+        return frame
+
+    def set_link_state(self, link_name: str, reference_frame: str, pose: Pose, linear, angular):
+        """set_link_state: link "model::link" put at ``pose`` with the (linear, angular) velocity of its origin,
+        all given in entity ``reference_frame`` as gazebo_ros takes them: the pose composed with the frame's, the
+        velocities minus the frame's, not rotated (upstream's arithmetic, kept).
+
+        Bullet moves a link of an articulated body only through its joints, so the whole model moves as one body
+        to put the link there, its joint positions unchanged (Gazebo moves the link alone and its joints pull it
+        and the rest together over the next steps). The model then turns about the link's origin with the given
+        twist: a robot's root link keeps the joints' velocities, as Gazebo's Link::SetLinearVel leaves the other
+        links', another link's model stops its joints, so that the link has exactly the given twist. A robot fixed
+        to the world (a root link "world") is refused: moving its links means moving its joints."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError("SetLinkState: link does not exist")
+        what = f"SetLinkState: link '{link_name}'"
+        check_state(what, pose, linear, angular)  # as sent: transformed, 1e300 would turn inf and NaN
+        frame = self._entity_pose(reference_frame)
+        if frame is not None:
+            frame_linear, frame_angular = self._entity_twist(reference_frame)
+            pose = compose(frame, pose)
+            linear, angular = tuple(np.subtract(linear, frame_linear)), tuple(np.subtract(angular, frame_angular))
+        elif reference_frame not in WORLD_FRAMES:
+            raise ModelError("SetLinkState: failed")
+        check_state(what, pose, linear, angular)
+        spawned = self.models.get(model)
+        if spawned is not None and spawned.robot.model.anchored:
+            raise ModelError(f"{what}: model '{model}' is fixed to the world, so its links move only through its "
+                             "joints (set_model_configuration); nothing was changed")
+        model_pose = self.engine.model_pose(model)
+        link_in_model = compose(inverse(model_pose), self._link_pose(model, link))
+        on_root = spawned is None or spawned.robot.link_index[spawned.robot.model.lumped_into[link][0]] == -1
+        self.engine.move_model(model, compose(pose, inverse(link_in_model)), pose.position, linear, angular,
+                               stop_joints=not on_root)
+        self.version += 1
+
+    # -- physics (physics_properties) ----------------------------------------------------------------------------------
+    def ode_config(self) -> physics_properties.OdeConfig:
+        return physics_properties.ode_config(self.engine.physics, self.engine.solver_iterations)
+
+    def set_physics(self, time_step: float, max_update_rate: float, gravity, ode: physics_properties.OdeConfig):
+        """set_physics_properties (physics_properties' module docstring); ModelError naming a bad value."""
+        physics, iterations, ignored = physics_properties.requested_physics(self.engine.physics, time_step,
+                                                                            max_update_rate, gravity, ode)
+        if ignored:
+            warn_once(_logger, f"SetPhysicsProperties: {', '.join(ignored)}: no Bullet counterpart; ignored")
+        self.engine.set_physics(physics, iterations)
+        self._schedule()  # plugins that act every step take the new step size
+
+    # -- link and joint properties (entity_properties) ---------------------------------------------------------------
+    def _physics_link(self, link_name: str, not_found: str) -> Tuple[str, str, int, Optional[int]]:
+        """(model, link, body, Bullet link index) of a "model::link"; the index is None for a link of a world model
+        with several links (welded into the body's base). ModelError(``not_found``) when there is no such link."""
+        model, _, link = link_name.partition("::")
+        if not link or link not in self.link_names(model):
+            raise ModelError(not_found)
+        body = self.engine.body_of(model)
+        if model in self.models:
+            return model, link, body, self.models[model].robot.link_index[link]
+        return model, link, body, -1 if len(self.world_models[model].links) == 1 else None
+
+    def link_properties(self, link_name: str) -> LinkProperties:
+        """get_link_properties (entity_properties' module docstring)."""
+        model, link, body, index = self._physics_link(
+            link_name, "GetLinkProperties: link not found, did you forget to scope the link by model name?")
+        if index is None:
+            described = next(item for item in self.world_models[model].links if item.name == link)
+            ixx, ixy, ixz, iyy, iyz, izz = described.inertia
+            return LinkProperties(described.inertial_pose, True, described.mass, ixx, ixy, ixz, iyy, iyz, izz)
+        mass, _, (ixx, iyy, izz), position, orientation = self.engine.client.getDynamicsInfo(body, index)[:5]
+        com = Pose(tuple(position), tuple(orientation))  # in the Bullet link's frame: a world model's base is its own
+        if model in self.world_models:
+            described = self.world_models[model]
+            com = compose(inverse(compose(inverse(described.pose), described.links[0].pose)), com)
+        return LinkProperties(com, not self.engine.weightless(body, index), mass, ixx, 0.0, 0.0, iyy, 0.0, izz)
+
+    def set_link_properties(self, link_name: str, requested: LinkProperties):
+        """set_link_properties: mass, the moments about the inertia's axes and gravity_mode (entity_properties'
+        module docstring); ModelError with upstream's message for an unknown link, naming the value for a bad one."""
+        model, link, body, index = self._physics_link(
+            link_name, "SetLinkProperties: link not found, did you forget to scope the link by model name?")
+        if index is None:
+            raise ModelError(f"SetLinkProperties: link '{link_name}': the links of world model '{model}' are welded "
+                             "into one body here; only a one-link model's properties can change")
+        if model in self.world_models and self.world_models[model].static:
+            raise ModelError(f"SetLinkProperties: link '{link_name}': model '{model}' is static (it has no mass and "
+                             "does not move); nothing was changed")
+        current = self.link_properties(link_name)
+        mass, moments, frame_changed = entity_properties.checked_link_properties(link_name, requested, current)
+        if frame_changed:
+            warn_once(_logger, f"SetLinkProperties: link '{link_name}': Bullet keeps a link's centre of mass and "
+                               "inertia axes; the mass and the moments about its axes are set, the rest ignored")
+        if (model, link) not in self._property_undo:
+            weightless = self.engine.weightless(body, index)
+
+            def undo():
+                self._set_mass(model, body, index, current.mass, (current.ixx, current.iyy, current.izz))
+                self.engine.set_weightless(body, index, weightless)
+            self._property_undo[(model, link)] = undo
+        self._set_mass(model, body, index, mass, moments)
+        self.engine.set_weightless(body, index, not requested.gravity_mode)
+
+    def _set_mass(self, model: str, body: int, index: int, mass: float, moments):
+        self.engine.client.changeDynamics(body, index, mass=mass, localInertiaDiagonal=moments)
+        if model in self.models:  # the wheel contact model shares the robot's weight among its wheels
+            self.engine.set_surfaces(self.models[model].robot, self.models[model].robot.driven_joints)
+
+    def _joint(self, joint_name: str, not_found: str) -> Tuple[str, str]:
+        movable = [(name, spawned.robot.movable_joints) for name, spawned in self.models.items()]
+        found = joint_efforts.find_joint(joint_name, movable)
+        if found is None:
+            raise ModelError(not_found)
+        return found
+
+    def joint_properties(self, joint_name: str) -> JointProperties:
+        """get_joint_properties: the joint's type (upstream always says REVOLUTE), the damping set_joint_properties
+        gave it, its position and rate."""
+        model, joint = self._joint(joint_name, "GetJointProperties: joint not found")
+        robot = self.models[model].robot
+        position, rate, _ = robot.joint_state([joint])[0]
+        damping = self.engine.joint_damping(robot.body, robot.joint_index[joint])
+        return JointProperties(entity_properties.JOINT_TYPES[robot.model.joints[joint].type], [damping], [position],
+                               [rate])
+
+    def set_joint_properties(self, joint_name: str, config):
+        """set_joint_properties with ODEJointProperties ``config`` (entity_properties' module docstring)."""
+        model, joint = self._joint(joint_name, "SetJointProperties: joint not found")
+        robot = self.models[model].robot
+        index = robot.joint_index[joint]
+        client = self.engine.client
+        lower, upper = client.getJointInfo(robot.body, index)[8:10]
+        if lower > upper:  # no limits; Bullet's stops, once set, are put out of reach instead (they stay)
+            lower, upper = -entity_properties.NO_STOP, entity_properties.NO_STOP
+        limits = self._joint_limits.get((model, joint), (lower, upper))
+        settings = entity_properties.checked_joint_settings(joint_name, config, *limits)
+        if settings.ignored:
+            warn_once(_logger, f"SetJointProperties: joint '{joint_name}': {', '.join(settings.ignored)} have no "
+                               "Bullet counterpart; ignored")
+        if (model, joint) not in self._property_undo:
+            def undo():
+                self.engine.set_joint_damping(robot.body, index, 0.0)
+                client.changeDynamics(robot.body, index, jointLowerLimit=lower, jointUpperLimit=upper)
+                self._joint_limits.pop((model, joint), None)
+            self._property_undo[(model, joint)] = undo
+        if settings.damping is not None:
+            self.engine.set_joint_damping(robot.body, index, settings.damping)
+        if settings.limits is not None:
+            client.changeDynamics(robot.body, index, jointLowerLimit=settings.limits[0],
+                                  jointUpperLimit=settings.limits[1])
+            self._joint_limits[(model, joint)] = settings.limits
+        if settings.motor is not None:
+            robot.set_joint_velocity(joint, *settings.motor)
 
     def model_properties(self, name: str) -> ModelProperties:
         """get_model_properties: the links and joints the physics has (a robot's after fixed-joint lumping, as
@@ -331,9 +541,10 @@ class Simulation:
         steps of a batch, so they do not end it."""
         now, step = self.sim_time, self.step_size
         batch = max(1, int(round(MAX_BATCH_SIM_SECONDS / step)))
-        wrench_steps = self.wrenches.steps_until_next(now, step)
-        if wrench_steps is not None:
-            batch = min(batch, wrench_steps)
+        for jobs in (self.wrenches, self.joint_efforts):
+            job_steps = jobs.steps_until_next(now, step)
+            if job_steps is not None:
+                batch = min(batch, job_steps)
         # A timer is part of its plugin: one that raises (an overflowing period) disables the plugin, not the loop.
         return min([batch] + [self._guarded(plugin, plugin.timer.steps_until_due, now, step) or sys.maxsize
                               for plugin in self._plugins])
@@ -343,6 +554,8 @@ class Simulation:
         count = max(1, min(max_steps, self.steps_to_next_event()))
         if self.wrenches.pending() or self.wrenches.applied:
             self._apply_wrenches()
+        if self.joint_efforts.pending():
+            self._apply_joint_efforts()
         recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
         per_step = [recorder for recorder in recorders if recorder is not None]
         per_step += self._every_step_calls
@@ -354,8 +567,11 @@ class Simulation:
         due = [plugin for plugin in self._plugins if self._guarded(plugin, plugin.timer.due, now)]
         if before_updates is not None:
             before_updates(now, bool(due))
+        counts = self.sensor_updates
         for plugin in due:
             self._guarded(plugin, plugin.update, now)
+            if plugin.sensor is not None:
+                counts[plugin] = counts.get(plugin, 0) + 1
         if self.viewer is not None:
             self.viewer.follow()
         return count
@@ -374,9 +590,9 @@ class Simulation:
         moving = [name for name in self.engine.model_names() if name not in names and not (
             name in self.world_models and self.world_models[name].static)]
         kept = {name: state for name, state in self.engine.body_states(moving).items() if state.finite}
-        steps = self.engine.steps
+        steps, time_offset = self.engine.steps, self.engine.time_offset
         self._rebuild()
-        self.engine.steps = steps
+        self.engine.steps, self.engine.time_offset = steps, time_offset
         for name, state in kept.items():
             self.engine.restore_body_state(name, state)
         self._frozen.update(names)
@@ -434,9 +650,14 @@ class Simulation:
             for sequence, generator in self._streams.values():
                 generator.bit_generator.state = np.random.PCG64(sequence).state
         else:
+            for undo in self._property_undo.values():
+                undo()
+            self._forget_set_properties()
             self.engine.reset_world()
         self._frozen.clear()
-        self.wrenches = BodyWrenches()  # resets repair what service calls left: wrenches "until cleared" too
+        # Resets repair what service calls left: wrenches and efforts "until cleared" too.
+        self.wrenches = BodyWrenches()
+        self.joint_efforts = JointEfforts()
         self._schedule()
         self.version += 1
         for plugin in list(self._plugins):
@@ -445,6 +666,7 @@ class Simulation:
     def _rebuild(self):
         """Every model built again in its original order, as a new run would: see Engine.restart."""
         self.engine.restart()
+        self._forget_set_properties()  # the models are loaded as described
         for entry in self._build_order:
             if isinstance(entry, str):
                 self.engine.respawn(self.models[entry].robot)
@@ -453,6 +675,10 @@ class Simulation:
             else:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
                 self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
+
+    def _forget_set_properties(self):
+        self._property_undo.clear()
+        self._joint_limits.clear()
 
     def __enter__(self) -> "Simulation":
         return self
