@@ -25,6 +25,7 @@ WORKSPACE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__fi
 MBOT = os.path.join(WORKSPACE, "mbot")
 SKIPPED = (".venv", ".git", "build", "devel", "out")
 BRIDGE_SOURCE = os.path.join(WORKSPACE, "src", "mbot_sim_bridge", "src", "mbot_sim_bridge")
+RECONFIGURE_SOURCE = os.path.join(WORKSPACE, "src", "dynamic_reconfigure", "src")
 
 
 def documents():
@@ -165,9 +166,10 @@ def world_files():
 
 @functools.lru_cache(maxsize=None)
 def bridge_names():
-    """Every string literal of the bridge's ROS layer and core: what it serves, publishes and reads."""
+    """Every string literal of the bridge's ROS layer and core, and of the dynamic_reconfigure server it runs for
+    its physics: what it serves, publishes and reads."""
     names = set()
-    for folder, _, files in os.walk(BRIDGE_SOURCE):
+    for folder, _, files in (*os.walk(BRIDGE_SOURCE), *os.walk(RECONFIGURE_SOURCE)):
         for name in files:
             if name.endswith(".py"):
                 names.update(re.findall(r"""["']~?([\w/]+)["']""", open(os.path.join(folder, name)).read()))
