@@ -2,9 +2,10 @@
 
 ``parse_world`` is plain XML work (sdformat 1.4 to 1.7): physics, gravity, models inline or through
 ``<include>``, links, collisions, friction, poses composed world_T_model · model_T_link · link_T_collision.
-The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns it into PyBullet
-bodies. Visuals, lights, scene and GUI are left out; physics-relevant elements that are not simulated
-(joints, plugins, unknown geometry) warn once each, naming file and line.
+The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns its rigid models into
+PyBullet bodies; a model with joints, sensors or plugins is read as a robot instead (``sdf_model``), which the
+simulation spawns as URDF robots are. Visuals, lights, scene and GUI are left out; physics-relevant elements
+that are not simulated (world plugins, unknown geometry) warn once each, naming file and line.
 """
 import os
 import xml.etree.ElementTree as ET
@@ -18,7 +19,8 @@ from ..log import get_logger, warn_once
 from .materials import sdf_material_rgba
 from .mesh import TriangleMesh, load_mesh
 from .model_path import MODEL_MANIFESTS, default_model_path, find_model_directory
-from .world_description import (SHAPE_KINDS, LinkDescription, ModelDescription, PhysicsConfig, Shape,
+from .sdf_model import ModelLevel, SdfToUrdf, is_articulated
+from .world_description import (SHAPE_KINDS, ArticulatedModel, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
 from ..xml_values import (XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute, read_number,
                           read_pose, read_text, read_vector, read_xml_file)
@@ -46,7 +48,8 @@ _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "g
                   "spherical_coordinates", "state", "frame", "road"}
 _WORLD_UNSUPPORTED = {"actor", "population", "plugin"}
 _MODEL_IGNORED = {"static", "pose", "self_collide", "allow_auto_disable", "enable_wind", "frame"}
-_MODEL_UNSUPPORTED = {"joint", "plugin", "gripper"}
+_MODEL_UNSUPPORTED = {"gripper"}
+_MODEL_ARTICULATION = {"joint", "plugin"}  # such a model is simulated as a robot (sdf_model)
 _LINK_IGNORED = {"pose", "inertial", "visual", "sensor", "self_collide", "enable_wind", "must_be_base_link",
                  "velocity_decay", "frame", "projector", "audio_sink", "audio_source", "battery", "light",
                  "particle_emitter"}
@@ -159,9 +162,11 @@ class _WorldParser:
                 continue
             unique[entry.name] = entry
             scope.add(entry.name, entry.pose, entry.pose_document)
-        models = tuple(self._model(entry, scope) for entry in unique.values())
-        return WorldDescription(world.get("name", "default"), path, self._physics(document, world), models,
-                                tuple(others))
+        models = [self._model(entry, scope) for entry in unique.values()]
+        return WorldDescription(world.get("name", "default"), path, self._physics(document, world),
+                                tuple(model for model in models if isinstance(model, ModelDescription)),
+                                tuple(others),
+                                tuple(model for model in models if isinstance(model, ArticulatedModel)))
 
     # Files ---------------------------------------------------------------------------------------------
 
@@ -262,18 +267,26 @@ class _WorldParser:
                             None if static is None else read_bool(static, document), document.where(include),
                             include)]
 
-    def _model(self, entry: _ModelEntry, parent: _Frames) -> ModelDescription:
+    def _model(self, entry: _ModelEntry, parent: _Frames):
+        """A ModelDescription (a rigid model), or an ArticulatedModel for one with joints, sensors or plugins."""
         static = entry.static
         if static is None:
             static = read_bool(entry.element.find("static"), entry.document, default=False)
         scope = _Frames(f"model '{entry.name}'", parent.frame(entry.name, entry.document, entry.element),
                         ("", "__model__"))
-        links = self._links(entry, scope, static, entry.name, prefix="", expanding=(entry.element,))
+        levels = self._levels(entry, scope, prefix="", expanding=(entry.element,))
+        if is_articulated(levels):
+            converted = SdfToUrdf(entry.name, entry.where, scope.origin, static, levels, self._mesh_path,
+                                  self._inertial).build()
+            return ArticulatedModel(entry.name, static, scope.origin, converted.robot, converted.root_in_model,
+                                    entry.source)
+        links = [self._link(link, level.document, level.frames, static, entry.name, level.prefix)
+                 for level in levels for link in level.element.findall("link")]
         return ModelDescription(entry.name, static, scope.origin, tuple(links), entry.source)
 
-    def _links(self, entry: _ModelEntry, scope: _Frames, static: bool, model: str, prefix: str,
-               expanding: Tuple[ET.Element, ...]) -> List[LinkDescription]:
-        """Links of a model and of the models nested in it, flattened; ``expanding`` are the <model>s on the way
+    def _levels(self, entry: _ModelEntry, scope: _Frames, prefix: str,
+                expanding: Tuple[ET.Element, ...]) -> List[ModelLevel]:
+        """A model and the models nested in it, with their frames; ``expanding`` are the <model>s on the way
         (an included file is read once, so including a model inside itself meets the same element again)."""
         element, document = entry.element, entry.document
         nested = []
@@ -287,19 +300,18 @@ class _WorldParser:
                 nested.extend(self._include(child, document))
             elif child.tag in _MODEL_UNSUPPORTED:
                 self._warn_unsupported(document, child)
-            elif child.tag not in _MODEL_IGNORED:
+            elif child.tag not in _MODEL_IGNORED and child.tag not in _MODEL_ARTICULATION:
                 self._warn_unknown(document, child, "model")
         for inner in nested:
             scope.add(inner.name, inner.pose, inner.pose_document)
-        links = [self._link(link, document, scope, static, model, prefix) for link in element.findall("link")]
+        levels = [ModelLevel(element, document, scope, prefix)]
         for inner in nested:
             if inner.element in expanding:
                 raise WorldError(f"{inner.where}: {inner.document.path} includes itself")
             inner_scope = _Frames(f"model '{inner.name}'", scope.frame(inner.name, document, inner.element),
                                   ("", "__model__"))
-            links += self._links(inner, inner_scope, static, model, f"{prefix}{inner.name}::",
-                                 expanding + (inner.element,))
-        return links
+            levels += self._levels(inner, inner_scope, f"{prefix}{inner.name}::", expanding + (inner.element,))
+        return levels
 
     def _link(self, link: ET.Element, document: XmlDocument, scope: _Frames, static: bool, model: str,
               prefix: str) -> LinkDescription:
@@ -443,8 +455,7 @@ class _WorldParser:
         what = f"<{element.tag}" + (f" name='{element.get('name')}'" if element.get("name") else "") + ">"
         if element.get("filename"):
             what += f" ({element.get('filename')})"
-        effect = "the model's links move as one rigid body" if element.tag == "joint" else "ignored"
-        warn_once(_log, f"{document.where(element)}: {what} is not simulated; {effect}")
+        warn_once(_log, f"{document.where(element)}: {what} is not simulated; ignored")
 
     @staticmethod
     def _warn_unknown(document: XmlDocument, element: ET.Element, parent: str) -> None:
