@@ -298,8 +298,8 @@ class SdfToUrdf:
         ET.SubElement(element, "limit", **attributes)
         dynamics = axis.find("dynamics") if axis is not None else None
         if dynamics is not None:
-            ET.SubElement(element, "dynamics", damping=repr(read_number(dynamics, "damping", document, 0.0, minimum=0.0)),
-                          friction=repr(read_number(dynamics, "friction", document, 0.0, minimum=0.0)))
+            ET.SubElement(element, "dynamics", **{tag: repr(read_number(dynamics, tag, document, 0.0, minimum=0.0))
+                                                  for tag in ("damping", "friction")})
             for tag in ("spring_stiffness", "spring_reference"):
                 if read_number(dynamics, tag, document, 0.0) != 0.0:
                     warn_once(_log, f"{document.where(dynamics.find(tag))}: joint '{joint.name}' of model "
