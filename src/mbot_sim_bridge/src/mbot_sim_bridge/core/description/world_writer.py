@@ -2,7 +2,8 @@
 
 Every world model is written back the way it was read, at its pose now: an ``<include>`` stays an include of
 the same ``<uri>`` with ``<name>`` and ``<pose>`` set; an inline ``<model>`` stays inline with its own links,
-whose poses in the model frame do not change (SDF joints are not simulated, so a model moves as one body).
+whose poses in the model frame do not change (a model with joints is written as read, so its joints start
+again where its file puts them).
 Lights, scene and the other non-model world elements are copied; physics and gravity come from the
 settings in use. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
 converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
@@ -15,12 +16,12 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
+from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence, Union
 
 from ..errors import WorldError
 from ..geometry import Pose, compose, inverse, rpy
 from .robot_model import RobotModel
-from .world_description import ModelDescription, PhysicsConfig, WorldDescription
+from .world_description import ArticulatedModel, ModelDescription, PhysicsConfig, WorldDescription
 
 SDF_VERSION = "1.6"
 # Frame semantics that came with 1.7; a copied model that uses them makes the file 1.7 (Gazebo 11 reads both).
@@ -39,10 +40,11 @@ class SavedRobot:
 
 
 class WorldSnapshot(NamedTuple):
-    models: List[ModelDescription]  # world models (the world file's and spawn_sdf_model's), in load order
+    # world models (the world file's and spawn_sdf_model's, those with joints too), in load order
+    models: List[Union[ModelDescription, ArticulatedModel]]
     poses: Dict[str, Pose]  # model name -> world pose of its model frame now
     robots: List[SavedRobot]  # URDF robots, with the world pose of every URDF link now (when asked for)
-    robot_names: List[str]  # every URDF robot, written or not
+    robot_names: List[str]  # every robot spawned from URDF, written or not
 
 
 def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
@@ -50,13 +52,19 @@ def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
     engine = simulation.engine
     models = [model for name, model in simulation.world_models.items() if name in engine.model_names()]
     poses = {model.name: engine.model_pose(model.name) for model in models}
+    # SDF models with joints run as robots; they are written back as read, at their model frame's pose now.
+    for name, articulated in simulation.sdf_robots.items():
+        models.append(articulated)
+        poses[name] = compose(engine.model_pose(name), inverse(articulated.root_in_model))
+    urdf_robots = [name for name in simulation.models if name not in simulation.sdf_robots]
     robots = []
     if with_robots:
-        for name, spawned in simulation.models.items():
+        for name in urdf_robots:
+            spawned = simulation.models[name]
             robot = spawned.robot
             links = {link: robot.link_world_pose(link) for link in robot.model.lumped_into}
             robots.append(SavedRobot(name, robot.model, links))
-    return WorldSnapshot(models, poses, robots, list(simulation.models))
+    return WorldSnapshot(models, poses, robots, urdf_robots)
 
 
 def pose_text(pose: Pose) -> str:
@@ -71,8 +79,8 @@ def _number(value: float) -> str:
     return "0" if text == "-0" else text
 
 
-def world_sdf(world: WorldDescription, models: Sequence[ModelDescription], poses: Mapping[str, Pose],
-              robots: Sequence[SavedRobot] = ()) -> str:
+def world_sdf(world: WorldDescription, models: Sequence[Union[ModelDescription, ArticulatedModel]],
+              poses: Mapping[str, Pose], robots: Sequence[SavedRobot] = ()) -> str:
     """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world) and ``robots``."""
     root = ET.Element("sdf", version=SDF_VERSION)
     element = ET.SubElement(root, "world", name=world.name)
@@ -80,7 +88,7 @@ def world_sdf(world: WorldDescription, models: Sequence[ModelDescription], poses
         element.append(copy.deepcopy(other))
     _physics(element, world.physics)
     base = os.path.dirname(os.path.abspath(world.path))
-    main_models = {id(model) for model in world.models}
+    main_models = {id(model) for model in world.models + world.robots}
     for model in models:
         if model.name not in poses:
             raise WorldError(f"no current pose for model '{model.name}'")
@@ -105,7 +113,7 @@ def _physics(world: ET.Element, physics: PhysicsConfig):
         ET.SubElement(constraints, tag).text = _number(getattr(physics, tag))
 
 
-def _model_element(model: ModelDescription, pose: Pose, base: Optional[str]) -> ET.Element:
+def _model_element(model: Union[ModelDescription, ArticulatedModel], pose: Pose, base: Optional[str]) -> ET.Element:
     if model.source is None:
         raise WorldError(f"model '{model.name}' was not read from SDF; it cannot be saved")
     element = copy.deepcopy(model.source)
