@@ -196,3 +196,24 @@ def test_save_world_writes_articulated_models_back(pendulum, tmp_path):
         model_frame = compose(again.engine.model_pose("double_pendulum"), inverse(reloaded.root_in_model))
         assert model_frame.position == pytest.approx(original.pose.position, abs=1e-6)
         assert again.models["double_pendulum"].robot.movable_joints == ["shoulder", "elbow"]
+
+
+def test_a_link_on_no_joint_moves_freely_in_its_model_as_in_gazebo(flat_world, tmp_path):
+    """A drawer cabinet with a loose box above it: the box is on no joint, so it falls on its own, and through the
+    cabinet to the ground, since links of one model do not collide without <self_collide> (Gazebo's default)."""
+    cabinet = """<sdf version="1.6"><model name="cabinet">
+      <link name="body"><pose>0 0 0.25 0 0 0</pose>
+        <collision name="c"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision></link>
+      <link name="drawer"><pose>0.1 0 0.25 0 0 0</pose>
+        <collision name="c"><geometry><box><size>0.4 0.4 0.1</size></box></geometry></collision></link>
+      <link name="loose_box"><pose>0 0 1.5 0 0 0</pose>
+        <collision name="c"><geometry><box><size>0.1 0.1 0.1</size></box></geometry></collision></link>
+      <joint name="slide" type="prismatic"><parent>body</parent><child>drawer</child>
+        <axis><xyz>1 0 0</xyz><limit><lower>0</lower><upper>0.3</upper></limit></axis></joint>
+    </model></sdf>"""
+    spawned_sdf(flat_world, tmp_path, cabinet, "cabinet", pose=(-5.0, 5.0, 0.0))
+    robot = flat_world.models["cabinet"].robot
+    assert robot.movable_joints == ["slide"]
+    flat_world.step(1500)
+    assert robot.link_world_pose("loose_box").position[2] == pytest.approx(0.05, abs=0.01)
+    assert robot.link_world_pose("body").position[2] == pytest.approx(0.25, abs=0.01)

@@ -67,18 +67,20 @@ class CachingBulletClient(BulletClient):
 class BodyState:
     pose: Tuple[Sequence[float], Sequence[float]]  # centre of mass position, orientation
     velocity: Tuple[Sequence[float], Sequence[float]]  # linear, angular
-    joints: List[Tuple[float, float]]  # position, velocity by joint index
+    # positions, velocities by joint index (one value each for one-axis joints, a quaternion for a spherical one)
+    joints: List[Tuple[Sequence[float], Sequence[float]]]
 
     @property
     def finite(self) -> bool:
-        return all(math.isfinite(value) for part in (*self.pose, *self.velocity, *self.joints) for value in part)
+        joint_values = [part for joint in self.joints for part in joint]
+        return all(math.isfinite(value) for part in (*self.pose, *self.velocity, *joint_values) for value in part)
 
 
 @dataclass
 class _InitialState:
     position: Tuple[float, float, float]
     orientation: Tuple[float, float, float, float]
-    joint_positions: Dict[int, float]
+    joint_positions: Dict[int, Sequence[float]]  # a quaternion for a spherical joint (planar, floating)
 
 
 def root_from_com(client: BulletClient, body: int) -> Pose:
@@ -155,12 +157,13 @@ class SpawnedRobot:
         # Bullet links of lumped links kept for their own surface: not links Gazebo has, so not in link_index.
         self.surface_link_index: Dict[str, int] = {}
         self.joint_index: Dict[str, int] = {}
+        free_chain = set(model.free_chain_links())  # planar and floating joints' links, not Gazebo's
         for index in range(client.getNumJoints(body)):
             info = client.getJointInfo(body, index)
             link_name = info[12].decode()
             if link_name in model.separate_surfaces:
                 self.surface_link_index[link_name] = index
-            else:
+            elif link_name not in free_chain:
                 self.link_index[link_name] = index
             self.joint_index[info[1].decode()] = index
         self.root_from_com = root_from_com(client, body)
@@ -282,6 +285,12 @@ class SpawnedRobot:
     def release_joint(self, joint_name: str):
         """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
         self.set_joint_velocity(joint_name, 0.0, 0.0)
+
+    def release_spherical_joint(self, joint_name: str):
+        """No motor on a spherical joint (a planar or floating joint's): PyBullet's holds it at rest."""
+        self.client.setJointMotorControlMultiDof(self.body, self.joint_index[joint_name], pybullet.POSITION_CONTROL,
+                                                 targetPosition=[0.0, 0.0, 0.0, 1.0], targetVelocity=[0.0, 0.0, 0.0],
+                                                 positionGain=0.0, velocityGain=0.0, force=[0.0, 0.0, 0.0])
 
 
 class Engine:
@@ -414,8 +423,11 @@ class Engine:
     def _place(self, robot: SpawnedRobot, driven_joints: Optional[Sequence[str]]):
         if driven_joints is not None:
             self.set_surfaces(robot, driven_joints)
-        for joint_name in robot.movable_joints:
+        for joint_name in robot.movable_joints + robot.model.free_chain_joints():
             robot.release_joint(joint_name)
+        for joint in robot.model.joints.values():
+            if joint.free:
+                robot.release_spherical_joint(joint.name)
         self.robots[robot.name] = robot
         # A link holding several collisions is named by its first: Bullet reports contacts per link. A separate
         # surface's Bullet link is named by its own, which Gazebo holds in the link it is lumped into.
@@ -574,7 +586,7 @@ class Engine:
         for name in names:
             body = self.body_of(name)
             count = client.getNumJoints(body)
-            joints = client.getJointStates(body, range(count)) if count else []
+            joints = client.getJointStatesMultiDof(body, range(count)) if count else []
             states[name] = BodyState(client.getBasePositionAndOrientation(body), client.getBaseVelocity(body),
                                      [(position, velocity) for position, velocity, *_ in joints])
         return states
@@ -583,15 +595,18 @@ class Engine:
         body = self.body_of(name)
         self.client.resetBasePositionAndOrientation(body, *state.pose)
         self.client.resetBaseVelocity(body, *state.velocity)
-        for index, (position, velocity) in enumerate(state.joints):
-            self.client.resetJointState(body, index, position, velocity)
+        if state.joints:
+            positions, velocities = zip(*state.joints)
+            self.client.resetJointStatesMultiDof(body, range(len(state.joints)), positions, velocities)
 
     def _restore_initial_state(self, body: int):
         initial = self._initial[body]
         self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
         self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
-        for index, position in initial.joint_positions.items():
-            self.client.resetJointState(body, index, position, 0.0)
+        if initial.joint_positions:
+            positions = list(initial.joint_positions.values())
+            self.client.resetJointStatesMultiDof(body, list(initial.joint_positions), positions,
+                                                 [[0.0] * (3 if len(q) == 4 else len(q)) for q in positions])
 
     def close(self):
         if self.client is not None:
@@ -679,6 +694,7 @@ class Engine:
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)
-        joints = {index: self.client.getJointState(body, index)[0]
-                  for index in range(self.client.getNumJoints(body))}
+        count = self.client.getNumJoints(body)
+        states = self.client.getJointStatesMultiDof(body, range(count)) if count else []
+        joints = dict(enumerate(position for position, *_ in states))
         self._initial[body] = _InitialState(tuple(position), tuple(orientation), joints)

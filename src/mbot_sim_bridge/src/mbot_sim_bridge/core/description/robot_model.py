@@ -28,8 +28,16 @@ from ..xml_values import (XmlDocument, check_range, parse_float, parse_floats, p
 _logger = get_logger(__name__)
 
 MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
-# PyBullet's URDF importer knows these; planar and floating joints are not importable into a multibody.
-SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
+# sdformat's URDF import writes no joint for these: the child link moves freely in the model (planar too, not
+# held to its plane), and no joint of that name exists for joint_states or -J. PyBullet's importer cannot
+# load them into a multibody, so each becomes a chain that holds nothing (see _add_free_chain).
+FREE_JOINT_TYPES = ("planar", "floating")
+SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",) + FREE_JOINT_TYPES
+# A free joint's chain: three prismatic joints along the parent's x, y and z, then a spherical joint, between
+# links without mass. Their names: the joint's own for the spherical one, these suffixes for the others.
+FREE_CHAIN_AXES = (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))
+# The chain's prismatic joints reach this far (m), beyond the farthest a model may be placed (engine.MAX_POSITION).
+_FREE_CHAIN_REACH = 1e6
 
 # <gazebo reference="link"> tags the bridge acts on.
 LINK_TAGS_USED = ("material", "mu1", "mu2", "fdir1", "sensor")
@@ -110,6 +118,14 @@ class Joint:
     def movable(self) -> bool:
         return self.type in MOVABLE_JOINT_TYPES
 
+    @property
+    def free(self) -> bool:
+        return self.type in FREE_JOINT_TYPES
+
+    def free_chain(self) -> List[Tuple[str, str]]:
+        """(Bullet link, prismatic joint) names of a free joint's chain, the links' first."""
+        return [(f"{self.name}__free_{axis}", f"{self.name}__free_{axis}_joint") for axis, _ in FREE_CHAIN_AXES]
+
 
 @dataclass
 class RobotModel:
@@ -136,6 +152,14 @@ class RobotModel:
 
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
+
+    def free_chain_links(self) -> List[str]:
+        """The Bullet links of the free joints' chains: no links Gazebo has."""
+        return [link for joint in self.joints.values() if joint.free for link, _ in joint.free_chain()]
+
+    def free_chain_joints(self) -> List[str]:
+        """The prismatic Bullet joints of the free joints' chains, to be left without a motor."""
+        return [name for joint in self.joints.values() if joint.free for _, name in joint.free_chain()]
 
     def collision_names(self) -> Dict[str, List[str]]:
         """Simulated link -> the names sdformat gives the collisions it holds: "L_collision" (then
@@ -495,7 +519,7 @@ def _drop_massless_moving_links(links, joints, source) -> List[str]:
     """Gazebo does not model a massless link on a moving joint; it drops it with its whole subtree."""
     dropped: List[str] = []
     for joint in list(joints.values()):
-        if joint.name not in joints or not joint.movable or links[joint.child].has_inertial:
+        if joint.name not in joints or not (joint.movable or joint.free) or links[joint.child].has_inertial:
             continue
         subtree = _subtree(joint.child, joints)
         warn_once(_logger, f"{source}: link '{joint.child}' has no <inertial> but moves on joint '{joint.name}'; like "
@@ -657,12 +681,29 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
     for joint in joints.values():
         if joint.type == "fixed" or joint.child in dropped:
             continue
-        element = copy.deepcopy(next(e for e in checked.findall("joint") if e.get("name") == joint.name))
         holder, offset = lumped_into[joint.parent]
+        if joint.free:
+            _add_free_chain(robot, joint, holder, compose(offset, joint.origin))
+            continue
+        element = copy.deepcopy(next(e for e in checked.findall("joint") if e.get("name") == joint.name))
         element.find("parent").set("link", holder)
         _move(element, offset, document)
         robot.append(element)
     return ElementTree.tostring(robot, encoding="unicode")
+
+
+def _add_free_chain(robot: ElementTree.Element, joint: Joint, holder: str, origin: Pose):
+    """A planar or floating joint as a chain that holds nothing: prismatic x, y, z (no motor, see the engine)
+    and a spherical joint between massless links, so the child moves as the free link sdformat makes it."""
+    parent = holder
+    for (link, prismatic), (_, axis) in zip(joint.free_chain(), FREE_CHAIN_AXES):
+        _add_inertial(ElementTree.SubElement(robot, "link", name=link), [])
+        element = _add_joint(robot, prismatic, "prismatic", parent, link, origin if parent == holder else IDENTITY)
+        ElementTree.SubElement(element, "axis", xyz=axis)
+        ElementTree.SubElement(element, "limit", lower=repr(-_FREE_CHAIN_REACH), upper=repr(_FREE_CHAIN_REACH),
+                               effort="0", velocity="0")
+        parent = link
+    _add_joint(robot, joint.name, "spherical", parent, joint.child, IDENTITY)
 
 
 def _move(element: ElementTree.Element, offset: Pose, document: XmlDocument):
@@ -680,11 +721,13 @@ def _set_origin(element: ElementTree.Element, pose: Pose):
     element.insert(0, origin)
 
 
-def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, child: str, origin: Pose):
+def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, child: str,
+               origin: Pose) -> ElementTree.Element:
     joint = ElementTree.SubElement(robot, "joint", name=name, type=kind)
     ElementTree.SubElement(joint, "parent", link=parent)
     ElementTree.SubElement(joint, "child", link=child)
     _set_origin(joint, origin)
+    return joint
 
 
 def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocument] = None):

@@ -13,7 +13,8 @@ SDF to URDF, as sdformat 9 reads SDF 1.4 to 1.7:
 - the joint axis is in the joint frame, in the model frame for SDF 1.4 and for 1.5/1.6's
   ``<use_parent_model_frame>``, and in any frame ``<xyz expressed_in>`` names (1.7);
 - a joint to ``world`` fixes the model to the world (URDF's ``world`` root); a ``<static>`` model is fixed there
-  with every joint fixed; a link without ``<inertial>`` has SDF's mass of 1 kg and unit moments;
+  with every joint fixed; a link on no joint moves freely (a URDF floating joint, which is built that way);
+  a link without ``<inertial>`` has SDF's mass of 1 kg and unit moments;
 - revolute without limits (SDF's ±1e16) is continuous; ``<dynamics>`` damping and friction become URDF's;
 - ball, universal, revolute2, screw and gearbox joints are refused with one line naming the joint: the URDF
   path builds one-axis joints only.
@@ -108,10 +109,7 @@ class SdfToUrdf:
         anchored = self.static or any(joint.parent == "world" for joint in joints)
         free = [name for name in links if name not in children]
         root = "world" if anchored else free[0]
-        welded = [name for name in free if name != root]
-        if welded and not self.static:
-            warn_once(_log, f"{self.label}: links {', '.join(welded)} are on no joint; each is fixed to "
-                            f"'{root}' (one model is one PyBullet body)")
+        unjointed = [name for name in free if name != root]
         frames = {name: links[name].world for name in free}
         frames.update({joint.child: joint.world for joint in joints})
         frames["world"] = self.model_pose
@@ -120,8 +118,10 @@ class SdfToUrdf:
             ET.SubElement(robot, "link", name="world")
         for name, link in links.items():
             self._link(robot, name, link, frames[name])
-        for name in welded:
-            self._fixed_joint(robot, f"{name}_weld", root, name, inverse(frames[root]), frames[name])
+        # A link on no joint moves freely in its model, as in Gazebo: URDF's floating joint is built that way.
+        for name in unjointed:
+            self._simple_joint(robot, f"{name}_free", root, name, inverse(frames[root]), frames[name],
+                              "fixed" if self.static else "floating")
         for joint in joints:
             self._joint(robot, joint, inverse(frames[joint.parent]), frames[joint.child])
         for level in self.levels:
@@ -266,15 +266,16 @@ class SdfToUrdf:
         return joints
 
     @staticmethod
-    def _fixed_joint(robot: ET.Element, name: str, parent: str, child: str, to_parent: Pose, frame: Pose):
-        joint = ET.SubElement(robot, "joint", name=name, type="fixed")
+    def _simple_joint(robot: ET.Element, name: str, parent: str, child: str, to_parent: Pose, frame: Pose,
+                     kind: str = "fixed"):
+        joint = ET.SubElement(robot, "joint", name=name, type=kind)
         ET.SubElement(joint, "parent", link=parent)
         ET.SubElement(joint, "child", link=child)
         _origin(joint, compose(to_parent, frame))
 
     def _joint(self, robot: ET.Element, joint: _Joint, to_parent: Pose, frame: Pose):
         if self.static or joint.kind == "fixed":
-            self._fixed_joint(robot, joint.name, joint.parent, joint.child, to_parent, frame)
+            self._simple_joint(robot, joint.name, joint.parent, joint.child, to_parent, frame)
             return
         document = joint.level.document
         axis = joint.element.find("axis")

@@ -166,7 +166,8 @@ def robot_model_element(robot: SavedRobot) -> ET.Element:
         if name in robot.link_poses:
             element.append(_link(link, model, compose(from_model, robot.link_poses[name])))
     for joint in model.joints.values():
-        if joint.parent in robot.link_poses and joint.child in robot.link_poses:
+        # A planar or floating joint is none in Gazebo: its child is a free link of the model.
+        if joint.parent in robot.link_poses and joint.child in robot.link_poses and not joint.free:
             element.append(_joint(joint))
     for plugin in model.plugins:
         element.append(copy.deepcopy(plugin))
