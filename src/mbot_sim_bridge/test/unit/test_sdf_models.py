@@ -13,7 +13,7 @@ from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.description.world_writer import take_snapshot, world_sdf, write_world_file
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import BridgeError
-from mbot_sim_bridge.core.geometry import compose, inverse, pose_from_xyz_rpy
+from mbot_sim_bridge.core.geometry import compose, inverse, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.simulation import Simulation
 from sensor_fixtures import measured_motion, plugin_of, world_simulation
@@ -138,7 +138,7 @@ DOOR = """<sdf version="{version}"><model name="door">
 
 
 @pytest.mark.parametrize("changes, message", [
-    ({"kind": "ball"}, "joint 'hinge': type 'ball' is not simulated"),
+    ({"kind": "universal"}, "joint 'hinge': type 'universal' is not simulated"),
     ({"kind": "hinge"}, "joint 'hinge': type 'hinge' is not an SDF joint type"),
     ({"parent": "frane"}, "joint 'hinge': <parent> 'frane' is not a link of the model"),
     ({"panel": "<pose>nan 0 0 0 0 0</pose>"}, "<pose>.*nan"),
@@ -217,3 +217,33 @@ def test_a_link_on_no_joint_moves_freely_in_its_model_as_in_gazebo(flat_world, t
     flat_world.step(1500)
     assert robot.link_world_pose("loose_box").position[2] == pytest.approx(0.05, abs=0.01)
     assert robot.link_world_pose("body").position[2] == pytest.approx(0.25, abs=0.01)
+
+
+def test_a_ball_joint_swings_freely_in_every_direction(flat_world, tmp_path):
+    """A rod hung from the world on a ball joint, started 0.3 rad off the vertical in x and y: it swings through
+    the bottom, and a reset puts it back where it started."""
+    rod = """<sdf version="1.6"><model name="ball_pendulum"><pose>5 5 2 0.3 0.3 0</pose>
+      <link name="rod"><inertial><pose>0 0 -0.5 0 0 0</pose><mass>1</mass>
+        <inertia><ixx>0.083</ixx><iyy>0.083</iyy><izz>0.001</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia>
+        </inertial></link>
+      <joint name="socket" type="ball"><parent>world</parent><child>rod</child></joint>
+    </model></sdf>"""
+    spawned_sdf(flat_world, tmp_path, rod, "ball_pendulum")
+    robot = flat_world.models["ball_pendulum"].robot
+    assert robot.movable_joints == []
+    start = robot.link_world_pose("rod")
+    lowest = min(_tilt(robot) for _ in range(40) if flat_world.step(10) is None)
+    assert _tilt_of(start) == pytest.approx(0.42, abs=0.01) and lowest < 0.1
+    assert robot.link_world_pose("rod").position == pytest.approx(start.position, abs=1e-4)  # the socket holds
+    flat_world.reset(simulation=False)
+    assert _tilt(robot) == pytest.approx(_tilt_of(start), abs=1e-6)
+
+
+def _tilt_of(pose):
+    """Angle between the rod (its link's -z) and the downward vertical."""
+    down = np.array(rotation_matrix(pose.orientation)) @ np.array([0.0, 0.0, -1.0])
+    return math.acos(max(-1.0, min(1.0, -down[2])))
+
+
+def _tilt(robot):
+    return _tilt_of(robot.link_world_pose("rod"))

@@ -287,7 +287,7 @@ class SpawnedRobot:
         self.set_joint_velocity(joint_name, 0.0, 0.0)
 
     def release_spherical_joint(self, joint_name: str):
-        """No motor on a spherical joint (a planar or floating joint's): PyBullet's holds it at rest."""
+        """No motor on a spherical joint (a ball joint, a planar or floating joint's): PyBullet's holds it."""
         self.client.setJointMotorControlMultiDof(self.body, self.joint_index[joint_name], pybullet.POSITION_CONTROL,
                                                  targetPosition=[0.0, 0.0, 0.0, 1.0], targetVelocity=[0.0, 0.0, 0.0],
                                                  positionGain=0.0, velocityGain=0.0, force=[0.0, 0.0, 0.0])
@@ -426,7 +426,7 @@ class Engine:
         for joint_name in robot.movable_joints + robot.model.free_chain_joints():
             robot.release_joint(joint_name)
         for joint in robot.model.joints.values():
-            if joint.free:
+            if joint.spherical:
                 robot.release_spherical_joint(joint.name)
         self.robots[robot.name] = robot
         # A link holding several collisions is named by its first: Bullet reports contacts per link. A separate
@@ -595,9 +595,12 @@ class Engine:
         body = self.body_of(name)
         self.client.resetBasePositionAndOrientation(body, *state.pose)
         self.client.resetBaseVelocity(body, *state.velocity)
-        if state.joints:
-            positions, velocities = zip(*state.joints)
-            self.client.resetJointStatesMultiDof(body, range(len(state.joints)), positions, velocities)
+        # Fixed joints have no state, and PyBullet refuses an empty one.
+        moving = [(index, joint) for index, joint in enumerate(state.joints) if joint[0]]
+        if moving:
+            indices, joints = zip(*moving)
+            positions, velocities = zip(*joints)
+            self.client.resetJointStatesMultiDof(body, indices, positions, velocities)
 
     def _restore_initial_state(self, body: int):
         initial = self._initial[body]
@@ -696,5 +699,5 @@ class Engine:
         position, orientation = self.client.getBasePositionAndOrientation(body)
         count = self.client.getNumJoints(body)
         states = self.client.getJointStatesMultiDof(body, range(count)) if count else []
-        joints = dict(enumerate(position for position, *_ in states))
+        joints = {index: position for index, (position, *_) in enumerate(states) if position}  # not fixed ones
         self._initial[body] = _InitialState(tuple(position), tuple(orientation), joints)

@@ -32,7 +32,9 @@ MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
 # held to its plane), and no joint of that name exists for joint_states or -J. PyBullet's importer cannot
 # load them into a multibody, so each becomes a chain that holds nothing (see _add_free_chain).
 FREE_JOINT_TYPES = ("planar", "floating")
-SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",) + FREE_JOINT_TYPES
+# PyBullet's own URDF type, for SDF ball joints (sdf_model): three free rotations, no joint_states entry.
+BALL_JOINT_TYPE = "spherical"
+SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",) + FREE_JOINT_TYPES + (BALL_JOINT_TYPE,)
 # A free joint's chain: three prismatic joints along the parent's x, y and z, then a spherical joint, between
 # links without mass. Their names: the joint's own for the spherical one, these suffixes for the others.
 FREE_CHAIN_AXES = (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))
@@ -121,6 +123,11 @@ class Joint:
     @property
     def free(self) -> bool:
         return self.type in FREE_JOINT_TYPES
+
+    @property
+    def spherical(self) -> bool:
+        """Whether its Bullet joint is spherical (a ball joint, and a free joint's last)."""
+        return self.free or self.type == BALL_JOINT_TYPE
 
     def free_chain(self) -> List[Tuple[str, str]]:
         """(Bullet link, prismatic joint) names of a free joint's chain, the links' first."""
@@ -519,7 +526,7 @@ def _drop_massless_moving_links(links, joints, source) -> List[str]:
     """Gazebo does not model a massless link on a moving joint; it drops it with its whole subtree."""
     dropped: List[str] = []
     for joint in list(joints.values()):
-        if joint.name not in joints or not (joint.movable or joint.free) or links[joint.child].has_inertial:
+        if joint.name not in joints or joint.type == "fixed" or links[joint.child].has_inertial:
             continue
         subtree = _subtree(joint.child, joints)
         warn_once(_logger, f"{source}: link '{joint.child}' has no <inertial> but moves on joint '{joint.name}'; like "

@@ -16,8 +16,9 @@ SDF to URDF, as sdformat 9 reads SDF 1.4 to 1.7:
   with every joint fixed; a link on no joint moves freely (a URDF floating joint, which is built that way);
   a link without ``<inertial>`` has SDF's mass of 1 kg and unit moments;
 - revolute without limits (SDF's ±1e16) is continuous; ``<dynamics>`` damping and friction become URDF's;
-- ball, universal, revolute2, screw and gearbox joints are refused with one line naming the joint: the URDF
-  path builds one-axis joints only.
+- a ball joint is PyBullet's spherical joint (free, no motor; not in joint_states, as Gazebo's publisher
+  reads one-axis joints); universal, revolute2, screw and gearbox joints are refused with one line naming the
+  joint.
 """
 import copy
 import xml.etree.ElementTree as ET
@@ -28,13 +29,14 @@ from ..geometry import Pose, compose, inverse, rotate, rpy
 from ..log import get_logger, warn_once
 from ..xml_values import XmlDocument, read_bool, read_number, read_pose, read_text, read_vector
 from .materials import sdf_material_rgba
-from .robot_model import RobotModel, parse_robot
+from .robot_model import BALL_JOINT_TYPE, RobotModel, parse_robot
 
 _log = get_logger(__name__)
 
 # SDF joint type -> URDF joint type.
-JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": "prismatic", "fixed": "fixed"}
-_REFUSED_JOINT_TYPES = ("ball", "universal", "revolute2", "screw", "gearbox")
+JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": "prismatic", "fixed": "fixed",
+               "ball": BALL_JOINT_TYPE}
+_REFUSED_JOINT_TYPES = ("universal", "revolute2", "screw", "gearbox")
 # SDF's default joint limits: beyond these a joint has none.
 UNLIMITED = 1e16
 # A link's children that become something in the URDF; the rest have no URDF counterpart and are left out.
@@ -274,8 +276,9 @@ class SdfToUrdf:
         _origin(joint, compose(to_parent, frame))
 
     def _joint(self, robot: ET.Element, joint: _Joint, to_parent: Pose, frame: Pose):
-        if self.static or joint.kind == "fixed":
-            self._simple_joint(robot, joint.name, joint.parent, joint.child, to_parent, frame)
+        if self.static or joint.kind in ("fixed", "ball"):
+            self._simple_joint(robot, joint.name, joint.parent, joint.child, to_parent, frame,
+                               "fixed" if self.static else JOINT_TYPES[joint.kind])
             return
         document = joint.level.document
         axis = joint.element.find("axis")

@@ -20,7 +20,7 @@ from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
 
 from ..errors import WorldError
 from ..geometry import Pose, compose, inverse, rpy
-from .robot_model import RobotModel
+from .robot_model import BALL_JOINT_TYPE, RobotModel
 from .world_description import ArticulatedModel, ModelDescription, PhysicsConfig, WorldDescription
 
 SDF_VERSION = "1.6"
@@ -256,7 +256,7 @@ def _visual_material(visual: ET.Element, urdf_material: Optional[ET.Element], ga
 
 
 def _joint(joint) -> ET.Element:
-    kind = "revolute" if joint.type == "continuous" else joint.type
+    kind = {"continuous": "revolute", BALL_JOINT_TYPE: "ball"}.get(joint.type, joint.type)
     element = ET.Element("joint", name=joint.name, type=kind)
     ET.SubElement(element, "parent").text = joint.parent
     ET.SubElement(element, "child").text = joint.child
