@@ -157,8 +157,9 @@ def test_bad_articulated_models_are_refused_in_one_line_and_the_simulation_goes_
 
 
 def test_joint_axes_follow_each_sdf_versions_frame_rules(tmp_path):
-    """A joint posed 90 degrees about x: its axis "0 0 1" is the joint frame's z (world -y... rotated) in 1.5/1.6,
-    the model frame's z in 1.4 and with use_parent_model_frame, and in the frame 1.7's expressed_in names."""
+    """A joint posed 90 degrees about x: its axis "0 0 1" is the joint frame's z in 1.5 and 1.6 (and 1.7 without
+    expressed_in), and the model frame's z, which is the joint frame's y, in 1.4, with use_parent_model_frame and
+    with expressed_in="__model__". URDF's axis is in the joint frame."""
     def axis(version, xyz):
         text = f"""<sdf version="{version}"><world name="w"><model name="m">
           <link name="a"/><link name="b"/>
@@ -168,7 +169,6 @@ def test_joint_axes_follow_each_sdf_versions_frame_rules(tmp_path):
         path.write_text(text)
         (robot,) = parse_world(str(path), []).robots
         return tuple(robot.robot.joints["j"].axis)
-    # URDF's axis is in the joint frame: the model's z seen from a frame turned 90 degrees about x is -y... its y.
     assert axis("1.6", "<xyz>0 0 1</xyz>") == pytest.approx((0.0, 0.0, 1.0))
     assert axis("1.4", "<xyz>0 0 1</xyz>") == pytest.approx((0.0, 1.0, 0.0), abs=1e-9)
     assert axis("1.6", "<xyz>0 0 1</xyz><use_parent_model_frame>true</use_parent_model_frame>") == pytest.approx(
@@ -247,3 +247,30 @@ def _tilt_of(pose):
 
 def _tilt(robot):
     return _tilt_of(robot.link_world_pose("rod"))
+
+
+def test_nested_models_and_sdf_1_7_frames_place_links_and_joints(tmp_path):
+    """A 1.7 model: a hinge frame attached to the base, a nested model's panel hinged there (its joint posed
+    relative_to the frame, its axis expressed in the model frame). Links of nested models are "inner::link"."""
+    text = """<sdf version="1.7"><world name="w"><model name="cupboard"><pose>1 2 0 0 0 1.5707963267948966</pose>
+      <link name="base"><pose>0 0 0.5 0 0 0</pose></link>
+      <frame name="hinge_frame" attached_to="base"><pose relative_to="base">0.3 0.2 0 0 0 0</pose></frame>
+      <model name="door"><pose relative_to="hinge_frame">0 0 0 0 0 0</pose>
+        <link name="panel"><pose>0.1 0 0 0 0 0</pose></link>
+      </model>
+      <joint name="hinge" type="revolute"><parent>base</parent><child>door::panel</child>
+        <pose relative_to="hinge_frame">0 0 0 0 0 0</pose>
+        <axis><xyz expressed_in="__model__">1 0 0</xyz><limit><lower>0</lower><upper>1.5</upper></limit></axis>
+      </joint></model></world></sdf>"""
+    path = tmp_path / "cupboard.world"
+    path.write_text(text)
+    (cupboard,) = parse_world(str(path), []).robots
+    joint = cupboard.robot.joints["hinge"]
+    assert (joint.parent, joint.child) == ("base", "door::panel")
+    # PyBullet composes poses in single precision.
+    assert joint.origin.position == pytest.approx((0.3, 0.2, 0.0), abs=1e-6)  # the hinge frame, seen from base
+    assert joint.axis == pytest.approx((1.0, 0.0, 0.0), abs=1e-6)  # the model's x, and no turn from model to joint
+    with Simulation(parse_world(str(path), []), CORE_PLUGINS) as simulation:
+        robot = simulation.models["cupboard"].robot
+        # The panel's URDF frame is its joint's: the hinge, at base (0, 0, 0.5) + (0.3, 0.2, 0) turned by 90 degrees.
+        assert robot.link_world_pose("door::panel").position == pytest.approx((0.8, 2.3, 0.5), abs=1e-5)
