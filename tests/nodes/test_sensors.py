@@ -42,6 +42,12 @@ class Collector:
         with self.lock:
             return list(self.messages)
 
+    def read(self, count=1):
+        """``wait``, then unsubscribe: a camera renders only while someone listens, and slows the tests after."""
+        messages = self.wait(count)
+        self.subscriber.unregister()
+        return messages
+
 
 class Kinect(unittest.TestCase):
     """kinect.test: the course's kinect robot alone, so that its TF tree is the odom one."""
@@ -106,8 +112,8 @@ class CameraAndImu(unittest.TestCase):
 
     def test_camera_image_and_the_red_plate_where_k_says(self):
         # spawn_model's robot namespace comes first: NodeHandle("camera_bot" + "/" + "/camera"), as in Gazebo.
-        image = Collector("/camera_bot/camera/image_raw", Image).wait(1)[-1]
-        info = Collector("/camera_bot/camera/camera_info", CameraInfo).wait(1)[-1]
+        image = Collector("/camera_bot/camera/image_raw", Image).read(1)[-1]
+        info = Collector("/camera_bot/camera/camera_info", CameraInfo).read(1)[-1]
         self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
                          (1280, 720, "rgb8", "camera_link"))
         self.assertAlmostEqual(info.K[0], 762.72, places=2)
@@ -155,10 +161,10 @@ class CameraAndImu(unittest.TestCase):
     def test_range_camera_and_p3d_of_the_world_files_own_models(self):
         """Models of the world file whose sensors and plugins run as a Gazebo user's would."""
         # Their plugins have no <robotNamespace>, so no model name is put in front: /sonar, /camera1/...
-        sonar = Collector("/sonar", Range).wait(3)
-        image = Collector("/camera1/image_raw", Image).wait(1)[-1]
-        info = Collector("/camera1/camera_info", CameraInfo).wait(1)[-1]
-        poses = Collector("/model_1/link_1/pose", Odometry).wait(40)
+        sonar = Collector("/sonar", Range).read(3)
+        image = Collector("/camera1/image_raw", Image).read(1)[-1]
+        info = Collector("/camera1/camera_info", CameraInfo).read(1)[-1]
+        poses = Collector("/model_1/link_1/pose", Odometry).read(40)
         ranges = [message.range for message in sonar]
         rolls = [2.0 * math.atan2(m.pose.pose.orientation.x, m.pose.pose.orientation.w) for m in poses]
         print(f"figure: sdf sonar {numpy.mean(ranges):.3f} m to the wall (geometry {SONAR_TO_WALL:.3f} m); camera1 "
