@@ -96,12 +96,13 @@ class _Joint(NamedTuple):
 
 class SdfToUrdf:
     """One model's URDF. ``mesh_path(uri, document)`` finds a mesh file; ``inertial(element, document, static,
-    label)`` reads and checks an ``<inertial>`` as world models' are (mass, inertia tuple, pose in the link)."""
+    label)`` reads and checks an ``<inertial>`` as world models' are (mass, inertia tuple, pose in the link);
+    ``check_link(element, document, model)`` warns for what a link has that is not simulated, as for those."""
 
     def __init__(self, name: str, where: str, model_pose: Pose, static: bool, levels: List[ModelLevel],
-                 mesh_path: Callable[[str, XmlDocument], Optional[str]], inertial: Callable):
+                 mesh_path: Callable[[str, XmlDocument], Optional[str]], inertial: Callable, check_link: Callable):
         self.name, self.where, self.model_pose, self.static, self.levels = name, where, model_pose, static, levels
-        self._mesh_path, self._inertial = mesh_path, inertial
+        self._mesh_path, self._inertial, self._check_link = mesh_path, inertial, check_link
         self.label = f"{where}: model '{name}'"
 
     def build(self) -> SdfRobot:
@@ -152,6 +153,10 @@ class SdfToUrdf:
         to_urdf = inverse(frame)
         urdf_link = ET.SubElement(robot, "link", name=name)
         label = f"link '{name}' of model '{self.name}'"
+        self._check_link(element, document, self.name)
+        if read_bool(element.find("self_collide"), document):
+            warn_once(_log, f"{document.where(element.find('self_collide'))}: <self_collide> in {label} is not "
+                            "simulated: links of one model do not collide with each other")
         mass, inertia, inertial_pose = self._inertial(element.find("inertial"), document, self.static, label)
         if mass > 0.0:
             inertial = ET.SubElement(urdf_link, "inertial")
@@ -173,10 +178,7 @@ class SdfToUrdf:
                 if rgba is not None:
                     material = ET.SubElement(urdf_part, "material", name=f"{name}_{part.get('name', '')}")
                     ET.SubElement(material, "color", rgba=" ".join(repr(float(v)) for v in rgba))
-        self._surface(gazebo, element, document)
-        for tag, urdf_tag in (("gravity", "gravity"), ("self_collide", "selfCollide")):
-            if element.find(tag) is not None:
-                ET.SubElement(gazebo, urdf_tag).text = str(read_bool(element.find(tag), document)).lower()
+        self._surface(gazebo, element, document, label)
         for sensor in element.findall("sensor"):
             placed = copy.deepcopy(sensor)
             for stale in placed.findall("pose"):
@@ -188,13 +190,18 @@ class SdfToUrdf:
             robot.append(gazebo)
 
     @staticmethod
-    def _surface(gazebo: ET.Element, link: ET.Element, document: XmlDocument):
+    def _surface(gazebo: ET.Element, link: ET.Element, document: XmlDocument, label: str):
         """The first collision's ODE friction as the link's ``<mu1>``/``<mu2>``/``<fdir1>``: a URDF link has one
         surface (see robot_model), Gazebo's URDF import writes these to every collision of the link."""
-        friction = next((found for found in (c.find("surface/friction/ode") for c in link.findall("collision"))
-                         if found is not None), None)
-        if friction is None:
+        frictions = [found for found in (c.find("surface/friction/ode") for c in link.findall("collision"))
+                     if found is not None]
+        if not frictions:
             return
+        friction = frictions[0]
+        texts = {tuple((found.findtext(tag) or "").strip() for tag in ("mu", "mu2", "fdir1")) for found in frictions}
+        if len(texts) > 1 or len(frictions) < len(link.findall("collision")):
+            warn_once(_log, f"{document.where(friction)}: the collisions of {label} have different friction; "
+                            "all take the first one's (one surface per link, as in a URDF)")
         for tag, urdf_tag in (("mu", "mu1"), ("mu2", "mu2")):
             if friction.find(tag) is not None:
                 ET.SubElement(gazebo, urdf_tag).text = repr(read_number(friction, tag, document, 1.0, minimum=0.0))

@@ -277,7 +277,7 @@ class _WorldParser:
         levels = self._levels(entry, scope, prefix="", expanding=(entry.element,))
         if is_articulated(levels):
             converted = SdfToUrdf(entry.name, entry.where, scope.origin, static, levels, self._mesh_path,
-                                  self._inertial).build()
+                                  self._inertial, self._check_link).build()
             return ArticulatedModel(entry.name, static, scope.origin, converted.robot, converted.root_in_model,
                                     entry.source)
         links = [self._link(link, level.document, level.frames, static, entry.name, level.prefix)
@@ -313,8 +313,9 @@ class _WorldParser:
             levels += self._levels(inner, inner_scope, f"{prefix}{inner.name}::", expanding + (inner.element,))
         return levels
 
-    def _link(self, link: ET.Element, document: XmlDocument, scope: _Frames, static: bool, model: str,
-              prefix: str) -> LinkDescription:
+    @classmethod
+    def _check_link(cls, link: ET.Element, document: XmlDocument, model: str) -> None:
+        """Warn once for what a link has that is not simulated (both for rigid models and those with joints)."""
         name = link.get("name", "")
         for tag, required in _LINK_DEFAULTS_REQUIRED.items():
             if read_bool(link.find(tag), document, default=required) != required:
@@ -322,7 +323,12 @@ class _WorldParser:
                                 f"in link '{name}' of model '{model}' is not simulated")
         for child in link:
             if child.tag not in _LINK_IGNORED and child.tag not in _LINK_DEFAULTS_REQUIRED and child.tag != "collision":
-                self._warn_unknown(document, child, "link")
+                cls._warn_unknown(document, child, "link")
+
+    def _link(self, link: ET.Element, document: XmlDocument, scope: _Frames, static: bool, model: str,
+              prefix: str) -> LinkDescription:
+        name = link.get("name", "")
+        self._check_link(link, document, model)
         pose = scope.frame(name, document, link)
         mass, inertia, inertial_pose = self._inertial(link.find("inertial"), document, static,
                                                       f"link '{name}' of model '{model}'")
