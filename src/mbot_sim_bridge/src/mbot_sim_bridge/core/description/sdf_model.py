@@ -39,7 +39,7 @@ JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": 
 _REFUSED_JOINT_TYPES = ("universal", "revolute2", "screw", "gearbox")
 # SDF's default joint limits: beyond these a joint has none.
 UNLIMITED = 1e16
-# A link's children that become something in the URDF; the rest have no URDF counterpart and are left out.
+# The SDF geometries URDF has; a collision or visual of another kind is left out with a warning.
 _URDF_SHAPES = ("box", "cylinder", "sphere", "mesh")
 
 
@@ -68,8 +68,8 @@ def _version(document: XmlDocument) -> Tuple[int, ...]:
         return (1, 6)
 
 
-def _origin(parent: ET.Element, pose: Pose, tag: str = "origin"):
-    ET.SubElement(parent, tag, xyz=" ".join(repr(float(v)) for v in pose.position),
+def _origin(parent: ET.Element, pose: Pose):
+    ET.SubElement(parent, "origin", xyz=" ".join(repr(float(v)) for v in pose.position),
                   rpy=" ".join(repr(float(v)) for v in rpy(pose.orientation)))
 
 
@@ -216,7 +216,7 @@ class SdfToUrdf:
             return None
         urdf = ET.Element("geometry")
         if shape.tag not in _URDF_SHAPES:
-            warn_once(_log, f"{document.where(shape)}: <{shape.tag}> in a model with joints is not simulated; "
+            warn_once(_log, f"{document.where(shape)}: <{shape.tag}> is not simulated in a model with joints, sensors or plugins; "
                             f"{label} left out")
             return None
         if shape.tag == "box":
