@@ -216,8 +216,8 @@ class SdfToUrdf:
             return None
         urdf = ET.Element("geometry")
         if shape.tag not in _URDF_SHAPES:
-            warn_once(_log, f"{document.where(shape)}: <{shape.tag}> is not simulated in a model with joints, sensors or plugins; "
-                            f"{label} left out")
+            warn_once(_log, f"{document.where(shape)}: <{shape.tag}> is not simulated in a model with joints, "
+                            f"sensors or plugins; {label} left out")
             return None
         if shape.tag == "box":
             size = read_vector(shape, "size", document, (1.0, 1.0, 1.0), positive=True)
