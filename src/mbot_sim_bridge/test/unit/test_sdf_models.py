@@ -274,3 +274,12 @@ def test_nested_models_and_sdf_1_7_frames_place_links_and_joints(tmp_path):
         robot = simulation.models["cupboard"].robot
         # The panel's URDF frame is its joint's: the hinge, at base (0, 0, 0.5) + (0.3, 0.2, 0) turned by 90 degrees.
         assert robot.link_world_pose("door::panel").position == pytest.approx((0.8, 2.3, 0.5), abs=1e-5)
+
+
+def test_an_include_adds_its_plugins_to_the_model_it_includes(flat_world, tmp_path):
+    """SDF 1.6's <include><plugin>: a rigid model:// box given ground truth by the world that includes it."""
+    world = """<sdf version="1.6"><world name="default"><include><uri>model://versioned_box</uri>
+      <plugin name="truth" filename="libgazebo_ros_p3d.so"><bodyName>link</bodyName><topicName>box_truth</topicName>
+      </plugin></include></world></sdf>"""
+    spawned_sdf(flat_world, tmp_path, world, "tracked_box", pose=(-5.0, -5.0, 1.0))
+    assert [type(plugin).__name__ for plugin in flat_world.models["tracked_box"].plugins] == ["P3D"]

@@ -22,7 +22,7 @@ SDF to URDF, as sdformat 9 reads SDF 1.4 to 1.7:
 """
 import copy
 import xml.etree.ElementTree as ET
-from typing import Callable, Dict, List, NamedTuple, Optional, Tuple
+from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 from ..errors import ModelError
 from ..geometry import Pose, compose, inverse, rotate, rpy
@@ -97,12 +97,15 @@ class _Joint(NamedTuple):
 class SdfToUrdf:
     """One model's URDF. ``mesh_path(uri, document)`` finds a mesh file; ``inertial(element, document, static,
     label)`` reads and checks an ``<inertial>`` as world models' are (mass, inertia tuple, pose in the link);
-    ``check_link(element, document, model)`` warns for what a link has that is not simulated, as for those."""
+    ``check_link(element, document, model)`` warns for what a link has that is not simulated, as for those;
+    ``added_plugins`` are the model's plugins given beside it (in its <include>)."""
 
     def __init__(self, name: str, where: str, model_pose: Pose, static: bool, levels: List[ModelLevel],
-                 mesh_path: Callable[[str, XmlDocument], Optional[str]], inertial: Callable, check_link: Callable):
+                 mesh_path: Callable[[str, XmlDocument], Optional[str]], inertial: Callable, check_link: Callable,
+                 added_plugins: Sequence[ET.Element] = ()):
         self.name, self.where, self.model_pose, self.static, self.levels = name, where, model_pose, static, levels
         self._mesh_path, self._inertial, self._check_link = mesh_path, inertial, check_link
+        self._added_plugins = added_plugins
         self.label = f"{where}: model '{name}'"
 
     def build(self) -> SdfRobot:
@@ -127,9 +130,9 @@ class SdfToUrdf:
                               "fixed" if self.static else "floating")
         for joint in joints:
             self._joint(robot, joint, inverse(frames[joint.parent]), frames[joint.child])
-        for level in self.levels:
-            for plugin in level.element.findall("plugin"):
-                ET.SubElement(robot, "gazebo").append(copy.deepcopy(plugin))
+        plugins = [plugin for level in self.levels for plugin in level.element.findall("plugin")]
+        for plugin in plugins + list(self._added_plugins):
+            ET.SubElement(robot, "gazebo").append(copy.deepcopy(plugin))
         urdf = ET.tostring(robot, encoding="unicode")
         return SdfRobot(parse_robot(urdf, self.label), compose(inverse(self.model_pose), frames[root]))
 

@@ -275,9 +275,11 @@ class _WorldParser:
         scope = _Frames(f"model '{entry.name}'", parent.frame(entry.name, entry.document, entry.element),
                         ("", "__model__"))
         levels = self._levels(entry, scope, prefix="", expanding=(entry.element,))
-        if is_articulated(levels):
+        # SDF 1.6 lets an <include> add plugins to the model it includes.
+        added_plugins = entry.source.findall("plugin") if entry.source.tag == "include" else []
+        if is_articulated(levels) or added_plugins:
             converted = SdfToUrdf(entry.name, entry.where, scope.origin, static, levels, self._mesh_path,
-                                  self._inertial, self._check_link).build()
+                                  self._inertial, self._check_link, added_plugins).build()
             return ArticulatedModel(entry.name, static, scope.origin, converted.robot, converted.root_in_model,
                                     entry.source)
         links = [self._link(link, level.document, level.frames, static, entry.name, level.prefix)
