@@ -143,6 +143,7 @@ DOOR = """<sdf version="{version}"><model name="door">
     ({"parent": "frane"}, "joint 'hinge': <parent> 'frane' is not a link of the model"),
     ({"panel": "<pose>nan 0 0 0 0 0</pose>"}, "<pose>.*nan"),
     ({"panel": "<inertial><mass>-2</mass></inertial>"}, "link 'panel' of model 'door': <mass>: .*-2"),
+    ({"panel": "<inertial><mass>1e300</mass></inertial>"}, "link 'panel' of model 'door': <mass>: .*1e.300"),
 ])
 def test_bad_articulated_models_are_refused_in_one_line_and_the_simulation_goes_on(flat_world, tmp_path, changes,
                                                                                     message):

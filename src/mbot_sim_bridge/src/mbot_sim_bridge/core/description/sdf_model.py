@@ -143,8 +143,9 @@ class SdfToUrdf:
             for element in level.element.findall("link"):
                 local = element.get("name", "")
                 name = level.prefix + local
-                if not local or name in links or name == "world":
-                    problem = "has no name" if not local else f"'{name}' is defined twice"
+                problem = ("has no name" if not local else f"'{name}' is defined twice" if name in links
+                           else "is named 'world', which joints use for the world" if name == "world" else None)
+                if problem:
                     raise ModelError(f"{level.document.where(element)}: model '{self.name}': a <link> {problem}")
                 links[name] = _Link(element, level, local, level.frames.frame(local, level.document, element))
         if not links:
