@@ -13,8 +13,10 @@ from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.description.world_writer import take_snapshot, world_sdf, write_world_file
 from mbot_sim_bridge.core.drives.diff_drive import DiffDrive
 from mbot_sim_bridge.core.errors import BridgeError
-from mbot_sim_bridge.core.geometry import compose, inverse, pose_from_xyz_rpy, rotation_matrix
+from mbot_sim_bridge.core.geometry import IDENTITY, Pose, compose, inverse, pose_from_xyz_rpy, rotation_matrix
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
+from mbot_sim_bridge.core.sensors.lidar import RaySensor
+from mbot_sim_bridge.core.sensors.p3d import P3D
 from mbot_sim_bridge.core.simulation import Simulation
 from sensor_fixtures import measured_motion, plugin_of, world_simulation
 
@@ -273,8 +275,9 @@ def test_nested_models_and_sdf_1_7_frames_place_links_and_joints(tmp_path):
     assert joint.axis == pytest.approx((1.0, 0.0, 0.0), abs=1e-6)  # the model's x, and no turn from model to joint
     with Simulation(parse_world(str(path), []), CORE_PLUGINS) as simulation:
         robot = simulation.models["cupboard"].robot
-        # The panel's URDF frame is its joint's: the hinge, at base (0, 0, 0.5) + (0.3, 0.2, 0) turned by 90 degrees.
-        assert robot.link_world_pose("door::panel").position == pytest.approx((0.8, 2.3, 0.5), abs=1e-5)
+        # The panel's own frame (not its joint's): base (0, 0, 0.5) + hinge (0.3, 0.2, 0) + (0.1, 0, 0), turned by
+        # 90 degrees.
+        assert robot.link_world_pose("door::panel").position == pytest.approx((0.8, 2.4, 0.5), abs=1e-5)
 
 
 def test_an_include_adds_its_plugins_to_the_model_it_includes(flat_world, tmp_path):
@@ -284,3 +287,63 @@ def test_an_include_adds_its_plugins_to_the_model_it_includes(flat_world, tmp_pa
       </plugin></include></world></sdf>"""
     spawned_sdf(flat_world, tmp_path, world, "tracked_box", pose=(-5.0, -5.0, 1.0))
     assert [type(plugin).__name__ for plugin in flat_world.models["tracked_box"].plugins] == ["P3D"]
+
+
+# An arm hung from the world on a joint posed away from the arm's frame (moved and turned in the arm), with a
+# laser on the arm and ground truth of the arm: what Gazebo reports for the arm is its own frame.
+MODEL_POSE, ARM_POSE = ((5.0, -5.0, 2.0), (0.0, 0.0, 0.0)), ((0.1, 0.0, -0.3), (0.0, 0.0, 0.3))
+PIVOT_POSE, LASER_POSE = ((0.0, 0.05, 0.3), (0.0, 0.0, 0.7)), ((0.05, 0.0, -0.2), (0.0, 0.3, 0.0))
+OFFSET_PENDULUM = f"""<sdf version="1.6"><model name="offset_pendulum">
+  <link name="arm"><pose>{" ".join(map(str, ARM_POSE[0] + ARM_POSE[1]))}</pose>
+    <inertial><pose>0 0 -0.1 0 0 0</pose><mass>1</mass>
+      <inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.001</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
+    <sensor name="laser" type="ray"><pose>{" ".join(map(str, LASER_POSE[0] + LASER_POSE[1]))}</pose>
+      <ray><scan><horizontal><samples>5</samples><min_angle>-0.1</min_angle><max_angle>0.1</max_angle></horizontal>
+      </scan><range><min>0.1</min><max>5</max></range></ray>
+      <plugin name="laser" filename="libgazebo_ros_laser.so"><topicName>scan</topicName><frameName>arm</frameName>
+      </plugin></sensor></link>
+  <joint name="pivot" type="revolute"><parent>world</parent><child>arm</child>
+    <pose>{" ".join(map(str, PIVOT_POSE[0] + PIVOT_POSE[1]))}</pose><axis><xyz>1 0 0</xyz></axis></joint>
+  <plugin name="truth" filename="libgazebo_ros_p3d.so"><bodyName>arm</bodyName><topicName>arm_truth</topicName>
+    <frameName>world</frameName></plugin>
+</model></sdf>"""
+
+
+def _arm_frame(angle):
+    """The arm's SDF frame in the world with the pivot turned by ``angle``, and the angular velocity per unit rate:
+    the arm at rest turned about the pivot's axis (its x, SDF 1.6) through the pivot's origin."""
+    arm = compose(pose_from_xyz_rpy(*MODEL_POSE), pose_from_xyz_rpy(*ARM_POSE))
+    pivot = compose(arm, pose_from_xyz_rpy(*PIVOT_POSE))
+    axis = np.array(rotation_matrix(pivot.orientation)) @ np.array([1.0, 0.0, 0.0])
+    turn = Pose((0.0, 0.0, 0.0), tuple(axis * math.sin(angle / 2.0)) + (math.cos(angle / 2.0),))
+    about_pivot = compose(Pose(pivot.position, IDENTITY.orientation),
+                          compose(turn, Pose(tuple(-np.array(pivot.position)), IDENTITY.orientation)))
+    return compose(about_pivot, arm), axis, np.array(pivot.position)
+
+
+def test_a_link_whose_joint_has_a_pose_reports_its_own_frame_as_in_gazebo(flat_world, tmp_path):
+    """PyBullet puts the arm's body frame at its joint; get_link_state, p3d and the arm's laser still see the
+    arm's SDF frame, at rest and swinging (its origin moving about the pivot)."""
+    spawned_sdf(flat_world, tmp_path, OFFSET_PENDULUM, "offset_pendulum", pose=MODEL_POSE[0])
+    spawned = flat_world.models["offset_pendulum"]
+    robot, truth = spawned.robot, plugin_of(spawned, P3D)
+    laser = plugin_of(spawned, RaySensor)
+    for angle in (None, 0.4):
+        if angle is not None:
+            flat_world.set_model_configuration("offset_pendulum", ["pivot"], [angle])
+            flat_world.step(30)
+        (angle, rate, _), = robot.joint_state(["pivot"])
+        expected, axis, pivot = _arm_frame(angle)
+        velocity = np.cross(axis * rate, np.array(expected.position) - pivot)
+        pose, linear, angular = flat_world.link_state("offset_pendulum::arm", "world")
+        ground_truth = truth.read(flat_world.sim_time)
+        for measured in (pose, ground_truth.pose, robot.link_world_pose("arm")):
+            assert measured.position == pytest.approx(expected.position, abs=1e-5)
+            assert np.array(rotation_matrix(measured.orientation)) == pytest.approx(
+                np.array(rotation_matrix(expected.orientation)), abs=1e-5)
+        for measured in (linear, ground_truth.linear):
+            assert measured == pytest.approx(velocity, abs=1e-4)
+        assert angular == pytest.approx(axis * rate, abs=1e-4)
+        sensor = compose(expected, pose_from_xyz_rpy(*LASER_POSE))
+        assert laser.sensor_world_pose().position == pytest.approx(sensor.position, abs=1e-5)
+    assert abs(rate) > 0.1  # swinging

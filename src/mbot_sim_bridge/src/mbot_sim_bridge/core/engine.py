@@ -178,15 +178,18 @@ class SpawnedRobot:
         return frame_velocity(self.client, self.body, self.root_pose().position)
 
     def link_world_pose(self, link_name: str) -> Pose:
-        """World pose of any URDF link's frame, lumped ones included."""
-        body_link, offset = self.model.lumped_into[link_name]
+        """World pose of any link's frame as Gazebo reports it, lumped ones included (RobotModel.reported_frame)."""
+        body_link, offset = self.model.reported_frame(link_name)
+        frame = self.body_link_pose(body_link)
+        return compose(frame, offset) if offset != IDENTITY else frame
+
+    def body_link_pose(self, body_link: str) -> Pose:
+        """World pose of a simulated link's URDF frame (its joint's frame), which its collisions are given in."""
         index = self.link_index[body_link]
         if index == -1:
-            frame = self.root_pose()
-        else:
-            state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
-            frame = Pose(tuple(state[4]), tuple(state[5]))
-        return compose(frame, offset) if offset != IDENTITY else frame
+            return self.root_pose()
+        state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
+        return Pose(tuple(state[4]), tuple(state[5]))
 
     def bullet_links(self, link_name: str) -> List[int]:
         """The Bullet links holding the collisions of a simulated link: its own and its separate surfaces'."""
@@ -206,7 +209,7 @@ class SpawnedRobot:
 
     def link_world_velocity(self, link_name: str):
         """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
-        index = self.link_index[self.model.lumped_into[link_name][0]]
+        index = self.link_index[self.model.reported_frame(link_name)[0]]
         point = self.link_world_pose(link_name).position
         if index == -1:
             return frame_velocity(self.client, self.body, point)
@@ -227,7 +230,7 @@ class SpawnedRobot:
     def recorded_link_states(self, link_name: str, rows: Sequence[tuple]) -> RecordedLinkStates:
         """From ``link_state_recorder``'s rows, the frame of ``link_name`` at each step, as ``link_world_pose``
         and ``link_world_velocity`` would have given it then."""
-        body_link, offset = self.model.lumped_into[link_name]
+        body_link, offset = self.model.reported_frame(link_name)
         on_base = self.link_index[body_link] == -1
         width = 13 if on_base else 27
         # np.fromiter over the nested tuples costs half of joining each row into one tuple for np.array.

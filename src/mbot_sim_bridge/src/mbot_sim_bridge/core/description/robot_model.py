@@ -150,12 +150,22 @@ class RobotModel:
     separate_surfaces: Tuple[str, ...] = ()
     # Links that roll (see _wheels): link -> (the first cylinder's centre, the unit axle), in the link frame.
     wheels: Dict[str, Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = field(default_factory=dict)
+    # Where a link's frame as Gazebo reports it is not its URDF frame (an SDF link whose joint has a <pose>: URDF
+    # and PyBullet put a link's frame at its joint): that frame, seen from the URDF frame.
+    reported_frames: Dict[str, Pose] = field(default_factory=dict)
 
     @property
     def anchored(self) -> bool:
         """Whether the root link is URDF's ``world``: Gazebo fixes the model to the world there, as arm
         descriptions mount their base with a fixed ``world_joint``."""
         return self.root == "world"
+
+    def reported_frame(self, link_name: str) -> Tuple[str, Pose]:
+        """The simulated link holding ``link_name`` and, in that link's URDF frame, the frame Gazebo reports for
+        ``link_name`` (poses, velocities, sensors, saving)."""
+        holder, offset = self.lumped_into[link_name]
+        own = self.reported_frames.get(link_name)
+        return holder, offset if own is None else compose(offset, own)
 
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]

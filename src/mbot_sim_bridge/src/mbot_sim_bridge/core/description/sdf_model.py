@@ -8,8 +8,9 @@ sensors, reset, NaN containment and saving are the URDF path's (only rigid model
 SDF to URDF, as sdformat 9 reads SDF 1.4 to 1.7:
 - a link's frame is its pose in the model; a joint's frame is its ``<pose>`` in the child link's frame (or in
   ``relative_to``/``frame``). URDF puts the joint frame at the child link's frame, and so does PyBullet's
-  multibody, so a child link's URDF frame is its joint's frame and its contents are moved into that frame (a
-  link whose joint has no pose keeps its own frame, as every link of TurtleBot3's model.sdf);
+  multibody, so a child link's URDF frame is its joint's frame and its contents are moved into that frame; the
+  SDF link frame, seen from there, is kept (``RobotModel.reported_frames``) and is what poses, velocities,
+  sensors and saving report for the link, as Gazebo does (a link whose joint has no pose is not moved);
 - the joint axis is in the joint frame, in the model frame for SDF 1.4 and for 1.5/1.6's
   ``<use_parent_model_frame>``, and in any frame ``<xyz expressed_in>`` names (1.7);
 - a joint to ``world`` fixes the model to the world (URDF's ``world`` root); a ``<static>`` model is fixed there
@@ -73,6 +74,11 @@ def _origin(parent: ET.Element, pose: Pose):
                   rpy=" ".join(repr(float(v)) for v in rpy(pose.orientation)))
 
 
+def _same_pose(first: Pose, second: Pose, tolerance: float = 1e-12) -> bool:
+    relative = compose(inverse(first), second)
+    return max(abs(value) for value in tuple(relative.position) + tuple(relative.orientation[:3])) <= tolerance
+
+
 def _pose_text(pose: Pose) -> str:
     return " ".join(repr(float(v)) for v in tuple(pose.position) + tuple(rpy(pose.orientation)))
 
@@ -133,8 +139,11 @@ class SdfToUrdf:
         plugins = [plugin for level in self.levels for plugin in level.element.findall("plugin")]
         for plugin in plugins + list(self._added_plugins):
             ET.SubElement(robot, "gazebo").append(copy.deepcopy(plugin))
-        urdf = ET.tostring(robot, encoding="unicode")
-        return SdfRobot(parse_robot(urdf, self.label), compose(inverse(self.model_pose), frames[root]))
+        model = parse_robot(ET.tostring(robot, encoding="unicode"), self.label)
+        for name, link in links.items():
+            if not _same_pose(frames[name], link.world):
+                model.reported_frames[name] = compose(inverse(frames[name]), link.world)
+        return SdfRobot(model, compose(inverse(self.model_pose), frames[root]))
 
     # -- links --------------------------------------------------------------------------------------------------
     def _links(self) -> Dict[str, _Link]:
@@ -187,7 +196,8 @@ class SdfToUrdf:
             placed = copy.deepcopy(sensor)
             for stale in placed.findall("pose"):
                 placed.remove(stale)
-            pose = compose(to_urdf, frames.resolve(sensor.find("pose"), document, default=link.local_name))
+            # In the SDF link frame: the frame sensors' links are reported in (RobotModel.reported_frames).
+            pose = compose(inverse(link.world), frames.resolve(sensor.find("pose"), document, default=link.local_name))
             ET.SubElement(placed, "pose").text = _pose_text(pose)
             gazebo.append(placed)
         if len(gazebo):
