@@ -180,25 +180,50 @@ def test_joint_axes_follow_each_sdf_versions_frame_rules(tmp_path):
     assert axis("1.7", "<xyz>0 0 1</xyz>") == pytest.approx((0.0, 0.0, 1.0))
 
 
-def test_save_world_writes_articulated_models_back(pendulum, tmp_path):
-    """The pendulum saved and read back is the same model with its joints, at its model pose."""
+def save(simulation, path):
+    snapshot = take_snapshot(simulation, with_robots=False)
+    write_world_file(str(path), world_sdf(simulation.world, snapshot.models, snapshot.poses, snapshot.robots,
+                                          snapshot.link_states))
+    return snapshot
+
+
+def test_save_world_writes_articulated_models_back_with_their_joints_where_they_stand(pendulum, tmp_path, caplog):
+    """The swinging pendulum saved and read back is the same model with its joints, at its model pose; its links'
+    world poses go into the world's <state> as Gazebo saves them, and reading that puts the joints where they
+    stood (a reset goes back to the model's own configuration, as Gazebo's). A NaN in the state is said and
+    left out."""
     pendulum.reset(simulation=True)
+    pendulum.set_model_configuration("double_pendulum", ["shoulder", "elbow"], [0.3, -0.2])
     pendulum.step(100)
-    snapshot = take_snapshot(pendulum, with_robots=False)
-    assert snapshot.robot_names == []
-    path = tmp_path / "saved.world"
-    write_world_file(str(path), world_sdf(pendulum.world, snapshot.models, snapshot.poses, snapshot.robots))
-    saved = ET.parse(path).getroot().find("world/model[@name='double_pendulum']")
-    assert [joint.get("name") for joint in saved.findall("joint")] == ["shoulder", "elbow"]
-    (reloaded,) = parse_world(str(path), []).robots
+    robot = pendulum.models["double_pendulum"].robot
+    standing = [position for position, _, _ in robot.joint_state(["shoulder", "elbow"])]
+    assert save(pendulum, tmp_path / "saved.world").robot_names == []
+    saved = ET.parse(tmp_path / "saved.world").getroot().find("world")
+    assert [joint.get("name") for joint in saved.findall("model[@name='double_pendulum']/joint")] == [
+        "shoulder", "elbow"]
+    assert [link.get("name") for link in saved.findall("state/model[@name='double_pendulum']/link")] == [
+        "upper", "lower"]
+    (reloaded,) = parse_world(str(tmp_path / "saved.world"), []).robots
     original = pendulum.sdf_robots["double_pendulum"]
     assert reloaded.pose.position == pytest.approx(original.pose.position, abs=1e-6)
     assert {name: (joint.type, joint.parent, joint.child) for name, joint in reloaded.robot.joints.items()} == {
         name: (joint.type, joint.parent, joint.child) for name, joint in original.robot.joints.items()}
-    with Simulation(parse_world(str(path), []), CORE_PLUGINS) as again:
+    assert [reloaded.joint_positions[name] for name in ("shoulder", "elbow")] == pytest.approx(standing, abs=1e-5)
+    with Simulation(parse_world(str(tmp_path / "saved.world"), []), CORE_PLUGINS) as again:
         model_frame = compose(again.engine.model_pose("double_pendulum"), inverse(reloaded.root_in_model))
         assert model_frame.position == pytest.approx(original.pose.position, abs=1e-6)
-        assert again.models["double_pendulum"].robot.movable_joints == ["shoulder", "elbow"]
+        robot_again = again.models["double_pendulum"].robot
+        assert robot_again.movable_joints == ["shoulder", "elbow"]
+        assert [p for p, _, _ in robot_again.joint_state(["shoulder", "elbow"])] == pytest.approx(standing, abs=1e-5)
+        again.reset(simulation=False)
+        assert [p for p, _, _ in robot_again.joint_state(["shoulder", "elbow"])] == pytest.approx([0, 0], abs=1e-9)
+    tree = ET.parse(tmp_path / "saved.world")
+    tree.find("world/state/model[@name='double_pendulum']/link[@name='lower']/pose").text = "nan 0 0 0 0 0"
+    tree.write(tmp_path / "nan.world")
+    caplog.clear()
+    (unreached,) = parse_world(str(tmp_path / "nan.world"), []).robots
+    assert unreached.joint_positions == {}
+    assert "nan.world:" in caplog.text and "<state> of model 'double_pendulum' left out" in caplog.text
 
 
 def test_a_link_on_no_joint_moves_freely_in_its_model_as_in_gazebo(flat_world, tmp_path):
@@ -347,3 +372,7 @@ def test_a_link_whose_joint_has_a_pose_reports_its_own_frame_as_in_gazebo(flat_w
         sensor = compose(expected, pose_from_xyz_rpy(*LASER_POSE))
         assert laser.sensor_world_pose().position == pytest.approx(sensor.position, abs=1e-5)
     assert abs(rate) > 0.1  # swinging
+    save(flat_world, tmp_path / "saved.world")
+    saved = next(model for model in parse_world(str(tmp_path / "saved.world"), TEST_MODEL_PATH).robots
+                 if model.name == "offset_pendulum")
+    assert saved.joint_positions["pivot"] == pytest.approx(angle, abs=1e-5)

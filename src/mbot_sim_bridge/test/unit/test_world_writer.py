@@ -52,7 +52,8 @@ def assert_same_pose(actual: Pose, expected: Pose, what: str):
 def save_and_reload(simulation, world, tmp_path, with_robots=False, name="saved.world"):
     snapshot = take_snapshot(simulation, with_robots)
     path = tmp_path / name
-    write_world_file(str(path), world_sdf(world, snapshot.models, snapshot.poses, snapshot.robots))
+    write_world_file(str(path), world_sdf(world, snapshot.models, snapshot.poses, snapshot.robots,
+                                          snapshot.link_states))
     return snapshot, path, parse_world(str(path), default_model_path())
 
 

@@ -131,6 +131,9 @@ class Simulation:
             self.spawn_robot(articulated.robot, articulated.name, compose(articulated.pose, articulated.root_in_model),
                              namespace)
             self.sdf_robots[articulated.name] = articulated
+            if articulated.joint_positions:  # a saved world's: reset_world goes back to the model's own, as Gazebo
+                self.set_model_configuration(articulated.name, list(articulated.joint_positions),
+                                             list(articulated.joint_positions.values()))
         return list(loaded.bodies) + [articulated.name for articulated in description.robots]
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:

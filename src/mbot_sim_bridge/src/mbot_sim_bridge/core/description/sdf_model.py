@@ -22,11 +22,12 @@ SDF to URDF, as sdformat 9 reads SDF 1.4 to 1.7:
   joint.
 """
 import copy
+import math
 import xml.etree.ElementTree as ET
 from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
 from ..errors import ModelError
-from ..geometry import Pose, compose, inverse, rotate, rpy
+from ..geometry import IDENTITY, Pose, compose, inverse, rotate, rpy
 from ..log import get_logger, warn_once
 from ..xml_values import XmlDocument, read_bool, read_number, read_pose, read_text, read_vector
 from .materials import sdf_material_rgba
@@ -351,3 +352,35 @@ class SdfToUrdf:
         world = rotate(orientation, vector)
         return rotate(inverse(frame).orientation, world)
 
+
+
+def state_joint_positions(state: ET.Element, document: XmlDocument, model_pose: Pose,
+                          robot: RobotModel) -> Dict[str, float]:
+    """The positions of a model's one-axis joints that put its links where a world's ``<state><model>`` has them
+    (Gazebo saves the world poses of links, no joint positions): the turn about, or the shift along, the joint's
+    axis from its origin to the child link's frame seen from the parent's. ``model_pose``: where the URDF's
+    ``world`` link is (the model frame), for joints to the world."""
+    links = {"world": model_pose}
+
+    def read_links(element: ET.Element, prefix: str):
+        for link in element.findall("link"):
+            links[prefix + link.get("name", "")] = read_pose(link.find("pose"), document)
+        for nested in element.findall("model"):
+            read_links(nested, f"{prefix}{nested.get('name', '')}::")
+
+    read_links(state, "")
+    positions = {}
+    for joint in robot.movable_joints():
+        if joint.parent not in links or joint.child not in links:
+            continue
+        parent, child = (compose(links[name], inverse(robot.reported_frames.get(name, IDENTITY)))
+                         for name in (joint.parent, joint.child))
+        motion = compose(inverse(joint.origin), compose(inverse(parent), child))
+        norm = math.sqrt(sum(value * value for value in joint.axis))
+        axis = [value / norm for value in joint.axis]
+        if joint.type == "prismatic":
+            positions[joint.name] = sum(a * b for a, b in zip(axis, motion.position))
+        else:
+            turn = 2.0 * math.atan2(sum(a * b for a, b in zip(axis, motion.orientation[:3])), motion.orientation[3])
+            positions[joint.name] = math.remainder(turn, 2.0 * math.pi)
+    return positions

@@ -7,6 +7,7 @@ PyBullet bodies; a model with joints, sensors or plugins is read as a robot inst
 simulation spawns as URDF robots are. Visuals, lights, scene and GUI are left out; physics-relevant elements
 that are not simulated (world plugins, unknown geometry) warn once each, naming file and line.
 """
+import dataclasses
 import os
 import xml.etree.ElementTree as ET
 from typing import List, NamedTuple, Optional, Sequence, Tuple
@@ -15,11 +16,12 @@ import numpy as np
 
 from ..errors import ModelError, WorldError
 from ..geometry import IDENTITY, Pose, compose
+from ..joints.model_configuration import requested_positions
 from ..log import get_logger, warn_once
 from .materials import sdf_material_rgba
 from .mesh import TriangleMesh, load_mesh
 from .model_path import MODEL_MANIFESTS, default_model_path, find_model_directory
-from .sdf_model import ModelLevel, SdfToUrdf, is_articulated
+from .sdf_model import ModelLevel, SdfToUrdf, is_articulated, state_joint_positions
 from .world_description import (SHAPE_KINDS, ArticulatedModel, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
 from ..xml_values import (XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute, read_number,
@@ -163,6 +165,10 @@ class _WorldParser:
             unique[entry.name] = entry
             scope.add(entry.name, entry.pose, entry.pose_document)
         models = [self._model(entry, scope) for entry in unique.values()]
+        state = world.find("state")
+        if state is not None:
+            models = [_with_state(model, state, document) if isinstance(model, ArticulatedModel) else model
+                      for model in models]
         return WorldDescription(world.get("name", "default"), path, self._physics(document, world),
                                 tuple(model for model in models if isinstance(model, ModelDescription)),
                                 tuple(others),
@@ -471,6 +477,23 @@ class _WorldParser:
 
 
 # --- Values -------------------------------------------------------------------------------------------------
+
+def _with_state(model: ArticulatedModel, state: ET.Element, document: XmlDocument) -> ArticulatedModel:
+    """A model with joints whose joints start where the world's <state> (a saved world) puts its links; a state
+    that cannot be reached (beyond a limit, a bad pose) is said once and the model starts as its file has it."""
+    found = next((element for element in state.findall("model") if element.get("name") == model.name), None)
+    if found is None:
+        return model
+    try:
+        positions = state_joint_positions(found, document, model.pose, model.robot)
+        requested_positions(model.robot.joints, [joint.name for joint in model.robot.movable_joints()],
+                            list(positions), list(positions.values()))
+    except (ModelError, WorldError) as error:
+        warn_once(_log, f"{document.where(found)}: <state> of model '{model.name}' left out ({error}); its joints "
+                        "start where its model puts them")
+        return model
+    return dataclasses.replace(model, joint_positions=positions)
+
 
 def _version(text: str) -> Tuple[int, ...]:
     try:

@@ -5,7 +5,7 @@ scene draws them, ``world_writer`` writes them back as SDF.
 """
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import Dict, Optional, Tuple
 
 import numpy as np
 
@@ -116,6 +116,8 @@ class ArticulatedModel:
     robot: RobotModel
     root_in_model: Pose  # the robot's root link frame in the model frame
     source: Optional[ET.Element] = field(default=None, compare=False, repr=False)
+    # Where the world's <state> puts its one-axis joints (a saved world), set when it is spawned.
+    joint_positions: Dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

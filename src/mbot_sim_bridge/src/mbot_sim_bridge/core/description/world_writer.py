@@ -2,8 +2,10 @@
 
 Every world model is written back the way it was read, at its pose now: an ``<include>`` stays an include of
 the same ``<uri>`` with ``<name>`` and ``<pose>`` set; an inline ``<model>`` stays inline with its own links,
-whose poses in the model frame do not change (a model with joints is written as read, so its joints start
-again where its file puts them).
+whose poses in the model frame do not change. A model with joints is written as read, and where its joints
+stand now goes, as Gazebo saves it, into the world's ``<state>``: the world pose of each of its links (SDF has
+no joint position in a model, and Gazebo's ModelState writes links only); reading the file sets the joints
+from those poses.
 Lights, scene and the other non-model world elements are copied; physics and gravity come from the
 settings in use. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
 converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
@@ -45,6 +47,7 @@ class WorldSnapshot(NamedTuple):
     poses: Dict[str, Pose]  # model name -> world pose of its model frame now
     robots: List[SavedRobot]  # URDF robots, with the world pose of every URDF link now (when asked for)
     robot_names: List[str]  # every robot spawned from URDF, written or not
+    link_states: Dict[str, Dict[str, Pose]]  # model with joints -> world pose of each of its links now
 
 
 def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
@@ -53,9 +56,12 @@ def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
     models = [model for name, model in simulation.world_models.items() if name in engine.model_names()]
     poses = {model.name: engine.model_pose(model.name) for model in models}
     # SDF models with joints run as robots; they are written back as read, at their model frame's pose now.
+    link_states = {}
     for name, articulated in simulation.sdf_robots.items():
         models.append(articulated)
         poses[name] = compose(engine.model_pose(name), inverse(articulated.root_in_model))
+        robot = simulation.models[name].robot
+        link_states[name] = {link: robot.link_world_pose(link) for link in robot.model.lumped_into if link != "world"}
     urdf_robots = [name for name in simulation.models if name not in simulation.sdf_robots]
     robots = []
     if with_robots:
@@ -64,7 +70,7 @@ def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
             robot = spawned.robot
             links = {link: robot.link_world_pose(link) for link in robot.model.lumped_into}
             robots.append(SavedRobot(name, robot.model, links))
-    return WorldSnapshot(models, poses, robots, urdf_robots)
+    return WorldSnapshot(models, poses, robots, urdf_robots, link_states)
 
 
 def pose_text(pose: Pose) -> str:
@@ -80,8 +86,10 @@ def _number(value: float) -> str:
 
 
 def world_sdf(world: WorldDescription, models: Sequence[Union[ModelDescription, ArticulatedModel]],
-              poses: Mapping[str, Pose], robots: Sequence[SavedRobot] = ()) -> str:
-    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world) and ``robots``."""
+              poses: Mapping[str, Pose], robots: Sequence[SavedRobot] = (),
+              link_states: Optional[Mapping[str, Mapping[str, Pose]]] = None) -> str:
+    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world), ``robots``, and
+    ``link_states`` (world link poses of models with joints) as a ``<state>``."""
     root = ET.Element("sdf", version=SDF_VERSION)
     element = ET.SubElement(root, "world", name=world.name)
     for other in world.others:
@@ -96,10 +104,29 @@ def world_sdf(world: WorldDescription, models: Sequence[Union[ModelDescription, 
         element.append(_model_element(model, poses[model.name], base if id(model) in main_models else None))
     for robot in robots:
         element.append(robot_model_element(robot))
+    if link_states:
+        element.append(_state(world.name, poses, link_states))
     if any(item.get(attribute) is not None for item in root.iter() for attribute in _SDF_1_7_ATTRIBUTES):
         root.set("version", "1.7")
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _state(world_name: str, poses: Mapping[str, Pose], link_states: Mapping[str, Mapping[str, Pose]]) -> ET.Element:
+    """Gazebo's ``<state>`` (SDF state.sdf) of the models with joints: model and link world poses; a nested
+    model's links ("inner::link") in a ``<model>`` of their own, as Gazebo's ModelState nests them."""
+    state = ET.Element("state", world_name=world_name)
+    for name, links in link_states.items():
+        model = ET.SubElement(state, "model", name=name)
+        ET.SubElement(model, "pose").text = pose_text(poses[name])
+        for link, pose in links.items():
+            parent = model
+            *scopes, local = link.split("::")
+            for scope in scopes:
+                nested = parent.find(f"model[@name='{scope}']")
+                parent = nested if nested is not None else ET.SubElement(parent, "model", name=scope)
+            ET.SubElement(ET.SubElement(parent, "link", name=local), "pose").text = pose_text(pose)
+    return state
 
 
 def _physics(world: ET.Element, physics: PhysicsConfig):
