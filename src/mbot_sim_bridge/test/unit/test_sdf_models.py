@@ -118,6 +118,9 @@ def test_a_turtlebot3_style_model_sdf_drives_as_cmd_vel_says(flat_world, tmp_pat
     print(f"figure: sdf_burger at ({linear}, {angular}): {speed:.4f} m/s, {rate:.4f} rad/s")
     assert speed == pytest.approx(linear, rel=0.05)
     assert rate == pytest.approx(angular, abs=0.05 * max(abs(angular), abs(linear) / 0.08))
+    # base_link is lumped into base_footprint at its fixed joint, 1 cm up; its SDF frame is the model origin too.
+    base_link, base_footprint = (spawned.robot.link_world_pose(link) for link in ("base_link", "base_footprint"))
+    assert base_link.position == pytest.approx(base_footprint.position, abs=1e-6)
 
 
 def test_spawn_sdf_model_puts_the_robot_namespace_in_every_plugin(flat_world, tmp_path):
