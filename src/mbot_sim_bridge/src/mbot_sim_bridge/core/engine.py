@@ -208,7 +208,7 @@ class SpawnedRobot:
         return self.client.getJointStates(self.body, indices) or ()
 
     def link_world_velocity(self, link_name: str):
-        """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
+        """World-frame (linear velocity of the origin of the frame link_world_pose gives; angular velocity)."""
         index = self.link_index[self.model.reported_frame(link_name)[0]]
         point = self.link_world_pose(link_name).position
         if index == -1:

@@ -353,7 +353,6 @@ class SdfToUrdf:
         return rotate(inverse(frame).orientation, world)
 
 
-
 def state_joint_positions(state: ET.Element, document: XmlDocument, model_pose: Pose,
                           robot: RobotModel) -> Dict[str, float]:
     """The positions of a model's one-axis joints that put its links where a world's ``<state><model>`` has them

@@ -116,7 +116,7 @@ class ArticulatedModel:
     robot: RobotModel
     root_in_model: Pose  # the robot's root link frame in the model frame
     source: Optional[ET.Element] = field(default=None, compare=False, repr=False)
-    # Where the world's <state> puts its one-axis joints (a saved world), set when it is spawned.
+    # Where the world's <state> (a saved world) puts its one-axis joints: set once it is spawned.
     joint_positions: Dict[str, float] = field(default_factory=dict)
 
 
