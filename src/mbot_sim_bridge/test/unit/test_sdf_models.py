@@ -338,8 +338,8 @@ OFFSET_PENDULUM = f"""<sdf version="1.6"><model name="offset_pendulum">
 
 
 def _arm_frame(angle):
-    """The arm's SDF frame in the world with the pivot turned by ``angle``, and the angular velocity per unit rate:
-    the arm at rest turned about the pivot's axis (its x, SDF 1.6) through the pivot's origin."""
+    """The arm's SDF frame in the world with the pivot turned by ``angle`` (the arm at rest turned about the pivot's
+    axis, its x in SDF 1.6, through the pivot's origin), that axis and that origin, world."""
     arm = compose(pose_from_xyz_rpy(*MODEL_POSE), pose_from_xyz_rpy(*ARM_POSE))
     pivot = compose(arm, pose_from_xyz_rpy(*PIVOT_POSE))
     axis = np.array(rotation_matrix(pivot.orientation)) @ np.array([1.0, 0.0, 0.0])
@@ -356,9 +356,9 @@ def test_a_link_whose_joint_has_a_pose_reports_its_own_frame_as_in_gazebo(flat_w
     spawned = flat_world.models["offset_pendulum"]
     robot, truth = spawned.robot, plugin_of(spawned, P3D)
     laser = plugin_of(spawned, RaySensor)
-    for angle in (None, 0.4):
-        if angle is not None:
-            flat_world.set_model_configuration("offset_pendulum", ["pivot"], [angle])
+    for setting in (None, 0.4):  # at rest as spawned, then set and swinging
+        if setting is not None:
+            flat_world.set_model_configuration("offset_pendulum", ["pivot"], [setting])
             flat_world.step(30)
         (angle, rate, _), = robot.joint_state(["pivot"])
         expected, axis, pivot = _arm_frame(angle)
