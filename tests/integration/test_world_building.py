@@ -102,8 +102,9 @@ def test_play_ground_saved_and_reloaded_keeps_every_pose_robot_left_out(ros_env,
                                                                 "--with-robots"))
     assert ET.parse(saved).getroot().find("world/model[@name='mbot']") is None
     assert ET.parse(with_robot).getroot().find("world/model[@name='mbot']") is not None
-    # The robot's model frame is its root link, where get_model_state puts it too.
-    robot = next(model for model in parse_world(str(with_robot)).models if model.name == "mbot")
+    # The robot's model frame is its root link, where get_model_state puts it too; with its joints and plugins it
+    # reads back as a robot.
+    robot = next(model for model in parse_world(str(with_robot)).robots if model.name == "mbot")
     assert_same_poses({"mbot": (robot.pose.position, robot.pose.orientation)}, {"mbot": before["mbot"]})
 
     relaunch(ros_env, launch, course, saved)

@@ -14,12 +14,14 @@ import rostest
 import tf2_ros
 from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import CameraInfo, Image, Imu, PointCloud2
+from sensor_msgs.msg import CameraInfo, Image, Imu, PointCloud2, Range
 
 from sim_support import WALL_TIMEOUT, Simulator, wait_for, yaw_of
 
 WALL_X = 1.65  # the wall's near face in the world (sensor_wall.world)
 PLATE = (2.495, 4.4, 0.3)  # the red plate's near-face centre
+SONAR_TO_WALL = 1.9 - 0.75  # sdf_wall's near face less the sonar's x (its model at 0.5, the sensor 0.25 ahead)
+PENDULUM_HINGE = (0.0, -13.0, 2.1)  # model_1's link_1 frame, on its hinge; the model starts turned 30 degrees
 # camera_link in base_footprint: base_link at z = 0.005/2 + 2 * 0.01975, camera 0.17 ahead, 0.10 above it.
 CAMERA_IN_BASE = numpy.array([0.17, 0.0, 0.0025 + 0.0395 + 0.10])
 
@@ -39,6 +41,12 @@ class Collector:
         wait_for(lambda: len(self.messages) >= count, what=f"{count} messages on {self.subscriber.name}")
         with self.lock:
             return list(self.messages)
+
+    def read(self, count=1):
+        """``wait``, then unsubscribe: a camera renders only while someone listens, and slows the tests after."""
+        messages = self.wait(count)
+        self.subscriber.unregister()
+        return messages
 
 
 class Kinect(unittest.TestCase):
@@ -89,7 +97,8 @@ class Kinect(unittest.TestCase):
 
 
 class CameraAndImu(unittest.TestCase):
-    """sensors.test: the course's camera robot and an IMU robot, each in its own namespace."""
+    """sensors.test: the course's camera robot and an IMU robot, each in its own namespace, and the world
+    file's own models with sensors and plugins (sensor_wall.world)."""
 
     @classmethod
     def setUpClass(cls):
@@ -103,8 +112,8 @@ class CameraAndImu(unittest.TestCase):
 
     def test_camera_image_and_the_red_plate_where_k_says(self):
         # spawn_model's robot namespace comes first: NodeHandle("camera_bot" + "/" + "/camera"), as in Gazebo.
-        image = Collector("/camera_bot/camera/image_raw", Image).wait(1)[-1]
-        info = Collector("/camera_bot/camera/camera_info", CameraInfo).wait(1)[-1]
+        image = Collector("/camera_bot/camera/image_raw", Image).read(1)[-1]
+        info = Collector("/camera_bot/camera/camera_info", CameraInfo).read(1)[-1]
         self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
                          (1280, 720, "rgb8", "camera_link"))
         self.assertAlmostEqual(info.K[0], 762.72, places=2)
@@ -148,6 +157,31 @@ class CameraAndImu(unittest.TestCase):
         self.assertLess(abs(yaw_of(sensor[-1].orientation) - 0.7), 0.01)
         self.assertEqual((truth.header.frame_id, truth.child_frame_id), ("world", "base_footprint"))
         self.assertAlmostEqual(truth.pose.pose.position.y, state.pose.position.y, places=3)
+
+    def test_range_camera_and_p3d_of_the_world_files_own_models(self):
+        """Models of the world file whose sensors and plugins run as a Gazebo user's would."""
+        # Their plugins have no <robotNamespace>, so no model name is put in front: /sonar, /camera1/...
+        sonar = Collector("/sonar", Range).read(3)
+        image = Collector("/camera1/image_raw", Image).read(1)[-1]
+        info = Collector("/camera1/camera_info", CameraInfo).read(1)[-1]
+        poses = Collector("/model_1/link_1/pose", Odometry).read(40)
+        ranges = [message.range for message in sonar]
+        rolls = [2.0 * math.atan2(m.pose.pose.orientation.x, m.pose.pose.orientation.w) for m in poses]
+        print(f"figure: sdf sonar {numpy.mean(ranges):.3f} m to the wall (geometry {SONAR_TO_WALL:.3f} m); camera1 "
+              f"{image.width}x{image.height} {image.header.frame_id}; p3d link_1 roll from {min(rolls):.3f} to "
+              f"{max(rolls):.3f} rad over {poses[-1].header.stamp.to_sec() - poses[0].header.stamp.to_sec():.2f} s")
+        self.assertEqual((sonar[-1].header.frame_id, sonar[-1].radiation_type), ("sonar_link", Range.ULTRASOUND))
+        self.assertLess(abs(numpy.mean(ranges) - SONAR_TO_WALL), 0.02)
+        self.assertEqual((image.width, image.height, image.encoding, image.header.frame_id),
+                         (320, 240, "rgb8", "camera_link"))
+        self.assertAlmostEqual(info.K[0], 160.0 / math.tan(1.3962634 / 2.0), places=2)
+        # The hinge stays put while the link swings through the upright, within its 30 degrees each way.
+        for message in poses:
+            position = message.pose.pose.position
+            self.assertLess(math.dist((position.x, position.y, position.z), PENDULUM_HINGE), 1e-3)
+        self.assertEqual(poses[-1].header.frame_id, "world")
+        self.assertLess(max(abs(roll) for roll in rolls), 0.5236 + 0.01)
+        self.assertGreater(max(rolls) - min(rolls), 0.05)
 
 
 def quaternion_matrix(q):

@@ -185,17 +185,17 @@ class GazeboRosApi:
         return self._guarded(SpawnModelResponse, spawn)
 
     def _spawn_sdf_model(self, request):
-        """A world-like model (no plugins or joints are simulated for SDF models), placed like gazebo_ros does."""
+        """A model placed as gazebo_ros places it; one with joints, sensors or plugins is spawned as a robot."""
         def spawn():
             name = request.model_name
             pose = self._new_model_pose(request)
-            world_xml = spawn_world_xml(resolve_package_uris(request.model_xml), name, pose)
+            world_xml = spawn_world_xml(resolve_package_uris(request.model_xml), name, pose, request.robot_namespace)
             # The world loader reads files (relative URIs resolve against them); a private temp file holds it.
             with tempfile.NamedTemporaryFile("w", prefix="mbot_spawn_", suffix=".world") as world_file:
                 world_file.write(world_xml)
                 world_file.flush()
                 description = parse_world(world_file.name, model_path())
-            if name not in self.sim.add_world(description):
+            if name not in self.sim.add_world(description, request.robot_namespace or "/"):
                 raise ModelError(f"model '{name}' has no collision geometry; nothing to simulate")
             rospy.loginfo(f"spawned SDF model '{name}' at {tuple(round(v, 3) for v in pose.position)}")
             return SpawnModelResponse(success=True, status_message="SpawnModel: Successfully spawned entity")

@@ -41,7 +41,8 @@ class SaveWorldHandler:
         if not os.path.isabs(path):
             raise WorldError(f"path '{path}' is not absolute (the simulator's working directory is not the caller's)")
         snapshot: WorldSnapshot = self.call_in_loop(lambda: take_snapshot(self.simulation, with_robots))
-        write_world_file(path, world_sdf(self.world, snapshot.models, snapshot.poses, snapshot.robots))
+        write_world_file(path, world_sdf(self.world, snapshot.models, snapshot.poses, snapshot.robots,
+                                         snapshot.link_states))
         left_out = [] if with_robots else snapshot.robot_names
         message = f"wrote {path}: {len(snapshot.models) + len(snapshot.robots)} models"
         if left_out:

@@ -117,7 +117,7 @@ def test_joint_blocks_warn_once_per_tag_except_provide_feedback(caplog):
     ("<sdf version='1.6'/>", "its root element is <sdf>, not <robot>"),
     ("<robot name='a'/>", "the robot has no <link>"),
     (robot(link("a"), joint("j", "continuous", "a", "b")), "joint 'j': child link 'b' is not defined"),
-    (robot(link("a"), link("b"), joint("j", "planar", "a", "b")), "joint 'j': type 'planar' is not supported"),
+    (robot(link("a"), link("b"), joint("j", "universal", "a", "b")), "joint 'j': type 'universal' is not supported"),
     (robot(link("a"), link("b")), "expected one root link, found a, b"),
     (robot(link("a"), link("b"), joint("j", "fixed", "a", "b", xyz="0 zero 0")), "expected 3 numbers, got '0 zero 0'"),
 ])

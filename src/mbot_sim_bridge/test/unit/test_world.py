@@ -477,8 +477,7 @@ def test_what_is_not_simulated_warns_once_each_and_the_rest_loads(caplog, client
         at("<teleporter") + "<teleporter> is not an SDF <world> element; ignored",
         at("<polyline>") + "<polyline> is not supported; collision 'post' of model 'door' skipped",
         at("<gravity>") + "<gravity>false</gravity> in link 'panel' of model 'door' is not simulated",
-        at("<joint") + "<joint name='hinge'> is not simulated; the model's links move as one rigid body",
-        at("door_opener") + "<plugin name='door_opener'> (libdoor_opener.so) is not simulated; ignored",
+        at("<gripper") + "<gripper name='grip'> is not simulated; ignored",
     ])
     assert [shape.name for shape in build(client, description).shapes] == ["box", "panel"]
 

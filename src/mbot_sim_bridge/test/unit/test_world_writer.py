@@ -52,7 +52,8 @@ def assert_same_pose(actual: Pose, expected: Pose, what: str):
 def save_and_reload(simulation, world, tmp_path, with_robots=False, name="saved.world"):
     snapshot = take_snapshot(simulation, with_robots)
     path = tmp_path / name
-    write_world_file(str(path), world_sdf(world, snapshot.models, snapshot.poses, snapshot.robots))
+    write_world_file(str(path), world_sdf(world, snapshot.models, snapshot.poses, snapshot.robots,
+                                          snapshot.link_states))
     return snapshot, path, parse_world(str(path), default_model_path())
 
 
@@ -177,11 +178,13 @@ def test_robots_are_left_out_unless_asked_for_then_inline_at_their_link_poses(tm
     assert model is not None and model.find("include") is None
     assert [plugin.get("filename") for plugin in model.findall("plugin")] == ["libgazebo_ros_diff_drive.so"]
     assert {joint.get("type") for joint in model.findall("joint")} <= {"revolute", "fixed", "prismatic"}
-    (loaded,) = [m for m in reloaded.models if m.name == "mbot"]
+    # Read back, it is a model with joints and a plugin again: a robot, whose links start where they were saved.
+    (loaded,) = [m for m in reloaded.robots if m.name == "mbot"]
     assert_same_pose(loaded.pose, robot.link_poses[robot.model.root], "mbot model frame")
-    for link in loaded.links:
-        assert_same_pose(link.pose, robot.link_poses[link.name], "mbot::" + link.name)
-    assert {link.name for link in loaded.links} == set(robot.link_poses)
+    assert set(loaded.robot.lumped_into) == set(robot.link_poses)
+    with Simulation(reloaded, {}) as again:
+        for link, pose in robot.link_poses.items():
+            assert_same_pose(again.models["mbot"].robot.link_world_pose(link), pose, "mbot::" + link)
     simulation.close()
 
 

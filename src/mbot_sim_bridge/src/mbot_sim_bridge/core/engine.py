@@ -69,18 +69,20 @@ class CachingBulletClient(BulletClient):
 class BodyState:
     pose: Tuple[Sequence[float], Sequence[float]]  # centre of mass position, orientation
     velocity: Tuple[Sequence[float], Sequence[float]]  # linear, angular
-    joints: List[Tuple[float, float]]  # position, velocity by joint index
+    # positions, velocities by joint index (one value each for one-axis joints, a quaternion for a spherical one)
+    joints: List[Tuple[Sequence[float], Sequence[float]]]
 
     @property
     def finite(self) -> bool:
-        return all(math.isfinite(value) for part in (*self.pose, *self.velocity, *self.joints) for value in part)
+        joint_values = [part for joint in self.joints for part in joint]
+        return all(math.isfinite(value) for part in (*self.pose, *self.velocity, *joint_values) for value in part)
 
 
 @dataclass
 class _InitialState:
     position: Tuple[float, float, float]
     orientation: Tuple[float, float, float, float]
-    joint_positions: Dict[int, float]
+    joint_positions: Dict[int, Sequence[float]]  # a quaternion for a spherical joint (planar, floating)
 
 
 def root_from_com(client: BulletClient, body: int) -> Pose:
@@ -157,12 +159,13 @@ class SpawnedRobot:
         # Bullet links of lumped links kept for their own surface: not links Gazebo has, so not in link_index.
         self.surface_link_index: Dict[str, int] = {}
         self.joint_index: Dict[str, int] = {}
+        free_chain = set(model.free_chain_links())  # planar and floating joints' links, not Gazebo's
         for index in range(client.getNumJoints(body)):
             info = client.getJointInfo(body, index)
             link_name = info[12].decode()
             if link_name in model.separate_surfaces:
                 self.surface_link_index[link_name] = index
-            else:
+            elif link_name not in free_chain:
                 self.link_index[link_name] = index
             self.joint_index[info[1].decode()] = index
         self.root_from_com = root_from_com(client, body)
@@ -177,15 +180,18 @@ class SpawnedRobot:
         return frame_velocity(self.client, self.body, self.root_pose().position)
 
     def link_world_pose(self, link_name: str) -> Pose:
-        """World pose of any URDF link's frame, lumped ones included."""
-        body_link, offset = self.model.lumped_into[link_name]
+        """World pose of any link's frame as Gazebo reports it, lumped ones included (RobotModel.reported_frame)."""
+        body_link, offset = self.model.reported_frame(link_name)
+        frame = self.body_link_pose(body_link)
+        return compose(frame, offset) if offset != IDENTITY else frame
+
+    def body_link_pose(self, body_link: str) -> Pose:
+        """World pose of a simulated link's URDF frame (its joint's frame), which its collisions are given in."""
         index = self.link_index[body_link]
         if index == -1:
-            frame = self.root_pose()
-        else:
-            state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
-            frame = Pose(tuple(state[4]), tuple(state[5]))
-        return compose(frame, offset) if offset != IDENTITY else frame
+            return self.root_pose()
+        state = self.client.getLinkState(self.body, index, computeForwardKinematics=True)
+        return Pose(tuple(state[4]), tuple(state[5]))
 
     def bullet_links(self, link_name: str) -> List[int]:
         """The Bullet links holding the collisions of a simulated link: its own and its separate surfaces'."""
@@ -204,8 +210,8 @@ class SpawnedRobot:
         return self.client.getJointStates(self.body, indices) or ()
 
     def link_world_velocity(self, link_name: str):
-        """World-frame (linear velocity of any URDF link frame's origin, lumped ones included; angular velocity)."""
-        index = self.link_index[self.model.lumped_into[link_name][0]]
+        """World-frame (linear velocity of the origin of the frame link_world_pose gives; angular velocity)."""
+        index = self.link_index[self.model.reported_frame(link_name)[0]]
         point = self.link_world_pose(link_name).position
         if index == -1:
             return frame_velocity(self.client, self.body, point)
@@ -226,7 +232,7 @@ class SpawnedRobot:
     def recorded_link_states(self, link_name: str, rows: Sequence[tuple]) -> RecordedLinkStates:
         """From ``link_state_recorder``'s rows, the frame of ``link_name`` at each step, as ``link_world_pose``
         and ``link_world_velocity`` would have given it then."""
-        body_link, offset = self.model.lumped_into[link_name]
+        body_link, offset = self.model.reported_frame(link_name)
         on_base = self.link_index[body_link] == -1
         width = 13 if on_base else 27
         # np.fromiter over the nested tuples costs half of joining each row into one tuple for np.array.
@@ -284,6 +290,12 @@ class SpawnedRobot:
     def release_joint(self, joint_name: str):
         """No motor: PyBullet holds every joint with a velocity motor unless told otherwise."""
         self.set_joint_velocity(joint_name, 0.0, 0.0)
+
+    def release_spherical_joint(self, joint_name: str):
+        """No motor on a spherical joint (a ball joint, a planar or floating joint's): PyBullet's holds it."""
+        self.client.setJointMotorControlMultiDof(self.body, self.joint_index[joint_name], pybullet.POSITION_CONTROL,
+                                                 targetPosition=[0.0, 0.0, 0.0, 1.0], targetVelocity=[0.0, 0.0, 0.0],
+                                                 positionGain=0.0, velocityGain=0.0, force=[0.0, 0.0, 0.0])
 
 
 class Engine:
@@ -435,8 +447,11 @@ class Engine:
     def _place(self, robot: SpawnedRobot, driven_joints: Optional[Sequence[str]]):
         if driven_joints is not None:
             self.set_surfaces(robot, driven_joints)
-        for joint_name in robot.movable_joints:
+        for joint_name in robot.movable_joints + robot.model.free_chain_joints():
             robot.release_joint(joint_name)
+        for joint in robot.model.joints.values():
+            if joint.spherical:
+                robot.release_spherical_joint(joint.name)
         self.robots[robot.name] = robot
         # A link holding several collisions is named by its first: Bullet reports contacts per link. A separate
         # surface's Bullet link is named by its own, which Gazebo holds in the link it is lumped into.
@@ -612,7 +627,7 @@ class Engine:
         for name in names:
             body = self.body_of(name)
             count = client.getNumJoints(body)
-            joints = client.getJointStates(body, range(count)) if count else []
+            joints = client.getJointStatesMultiDof(body, range(count)) if count else []
             states[name] = BodyState(client.getBasePositionAndOrientation(body), client.getBaseVelocity(body),
                                      [(position, velocity) for position, velocity, *_ in joints])
         return states
@@ -621,15 +636,21 @@ class Engine:
         body = self.body_of(name)
         self.client.resetBasePositionAndOrientation(body, *state.pose)
         self.client.resetBaseVelocity(body, *state.velocity)
-        for index, (position, velocity) in enumerate(state.joints):
-            self.client.resetJointState(body, index, position, velocity)
+        # Fixed joints have no state, and PyBullet refuses an empty one.
+        moving = [(index, joint) for index, joint in enumerate(state.joints) if joint[0]]
+        if moving:
+            indices, joints = zip(*moving)
+            positions, velocities = zip(*joints)
+            self.client.resetJointStatesMultiDof(body, indices, positions, velocities)
 
     def _restore_initial_state(self, body: int):
         initial = self._initial[body]
         self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
         self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
-        for index, position in initial.joint_positions.items():
-            self.client.resetJointState(body, index, position, 0.0)
+        if initial.joint_positions:
+            positions = list(initial.joint_positions.values())
+            self.client.resetJointStatesMultiDof(body, list(initial.joint_positions), positions,
+                                                 [[0.0] * (3 if len(q) == 4 else len(q)) for q in positions])
 
     def close(self):
         if self.client is not None:
@@ -764,6 +785,7 @@ class Engine:
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)
-        joints = {index: self.client.getJointState(body, index)[0]
-                  for index in range(self.client.getNumJoints(body))}
+        count = self.client.getNumJoints(body)
+        states = self.client.getJointStatesMultiDof(body, range(count)) if count else []
+        joints = {index: position for index, (position, *_) in enumerate(states) if position}  # not fixed ones
         self._initial[body] = _InitialState(tuple(position), tuple(orientation), joints)

@@ -31,7 +31,7 @@ from .parameters import Parameters
 from .plugin import Plugin, PluginContext, SpawnedModel
 from .cameras.render_scene import RenderScene
 from .description.robot_model import RobotModel
-from .description.world_description import ModelDescription, WorldDescription
+from .description.world_description import ArticulatedModel, ModelDescription, WorldDescription
 from .viewer import Viewer
 from .world_bodies import load_world
 
@@ -75,6 +75,8 @@ class Simulation:
         self.models: Dict[str, SpawnedModel] = {}
         # World models (from the .world and spawn_sdf_model) as described, by name.
         self.world_models: Dict[str, ModelDescription] = {}
+        # SDF models with joints, sensors or plugins (also in ``models``, as robots), by name.
+        self.sdf_robots: Dict[str, ArticulatedModel] = {}
         self._streams: Dict[str, Tuple[np.random.SeedSequence, np.random.Generator]] = {}
         # What was built, in order (a WorldDescription, or the name of a robot), for reset_simulation's rebuild.
         self._build_order: List[object] = []
@@ -122,9 +124,11 @@ class Simulation:
         return self._streams[name][1]
 
     # -- spawn and delete ----------------------------------------------------------------------------------------
-    def add_world(self, description: WorldDescription) -> List[str]:
-        """Build the models of a world (the loaded one, or one spawn_sdf_model wraps); returns the names added."""
-        duplicates = [model.name for model in description.models if model.name in self.model_names()]
+    def add_world(self, description: WorldDescription, namespace: str = "/") -> List[str]:
+        """Build the models of a world (the loaded one, or one spawn_sdf_model wraps); returns the names added.
+        Models with joints, sensors or plugins are spawned as robots, in ``namespace``."""
+        duplicates = [model.name for model in description.models + description.robots
+                      if model.name in self.model_names()]
         if duplicates:
             raise ModelError(f"SpawnModel: Failure - entity already exists: {', '.join(duplicates)}")
         loaded = load_world(self.engine.client, description)
@@ -134,7 +138,14 @@ class Simulation:
                 self.world_models[model.name] = model
         self._build_order.append(description)
         self.version += 1
-        return list(loaded.bodies)
+        for articulated in description.robots:
+            self.spawn_robot(articulated.robot, articulated.name, compose(articulated.pose, articulated.root_in_model),
+                             namespace)
+            self.sdf_robots[articulated.name] = articulated
+            if articulated.joint_positions:  # a saved world's: reset_world goes back to the model's own, as Gazebo
+                self.set_model_configuration(articulated.name, list(articulated.joint_positions),
+                                             list(articulated.joint_positions.values()))
+        return list(loaded.bodies) + [articulated.name for articulated in description.robots]
 
     def spawn_robot(self, model: RobotModel, name: str, pose: Pose = IDENTITY, namespace: str = "/") -> SpawnedModel:
         """Put a parsed robot in the engine with its plugins; on any error, leave nothing of it behind."""
@@ -176,6 +187,7 @@ class Simulation:
             self._frozen.discard(name)
             self._schedule()
         self.world_models.pop(name, None)
+        self.sdf_robots.pop(name, None)
         self.wrenches.clear(name)
         self.joint_efforts.clear(name)
         for key in [key for key in self._property_undo if key[0] == name]:

@@ -28,8 +28,18 @@ from ..xml_values import (XmlDocument, check_range, parse_float, parse_floats, p
 _logger = get_logger(__name__)
 
 MOVABLE_JOINT_TYPES = ("continuous", "revolute", "prismatic")
-# PyBullet's URDF importer knows these; planar and floating joints are not importable into a multibody.
-SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",)
+# sdformat's URDF import writes no joint for these: the child link moves freely in the model (planar too, not
+# held to its plane), and no joint of that name exists for joint_states or -J. PyBullet's importer cannot
+# load them into a multibody, so each becomes a chain that holds nothing (see _add_free_chain).
+FREE_JOINT_TYPES = ("planar", "floating")
+# PyBullet's own URDF type, for SDF ball joints (sdf_model): three free rotations, no joint_states entry.
+BALL_JOINT_TYPE = "spherical"
+SUPPORTED_JOINT_TYPES = MOVABLE_JOINT_TYPES + ("fixed",) + FREE_JOINT_TYPES + (BALL_JOINT_TYPE,)
+# A free joint's chain: three prismatic joints along the parent's x, y and z, then a spherical joint, between
+# links without mass. Their names: the joint's own for the spherical one, these suffixes for the others.
+FREE_CHAIN_AXES = (("x", "1 0 0"), ("y", "0 1 0"), ("z", "0 0 1"))
+# The chain's prismatic joints reach this far (m), beyond the farthest a model may be placed (engine.MAX_POSITION).
+_FREE_CHAIN_REACH = 1e6
 
 # <gazebo reference="link"> tags the bridge acts on.
 LINK_TAGS_USED = ("material", "mu1", "mu2", "fdir1", "sensor")
@@ -118,6 +128,19 @@ class Joint:
     def movable(self) -> bool:
         return self.type in MOVABLE_JOINT_TYPES
 
+    @property
+    def free(self) -> bool:
+        return self.type in FREE_JOINT_TYPES
+
+    @property
+    def spherical(self) -> bool:
+        """Whether its Bullet joint is spherical (a ball joint, and a free joint's last)."""
+        return self.free or self.type == BALL_JOINT_TYPE
+
+    def free_chain(self) -> List[Tuple[str, str]]:
+        """(Bullet link, prismatic joint) names of a free joint's chain, the links' first."""
+        return [(f"{self.name}__free_{axis}", f"{self.name}__free_{axis}_joint") for axis, _ in FREE_CHAIN_AXES]
+
 
 @dataclass
 class RobotModel:
@@ -138,6 +161,9 @@ class RobotModel:
     # The URDF text parsed: a plugin that reads the same text from a parameter reuses this model (and its warnings
     # are said once, not once per reading).
     xml: str = ""
+    # Where a link's frame as Gazebo reports it is not its URDF frame (an SDF link whose joint has a <pose>: URDF
+    # and PyBullet put a link's frame at its joint): that frame, seen from the URDF frame.
+    reported_frames: Dict[str, Pose] = field(default_factory=dict)
 
     @property
     def anchored(self) -> bool:
@@ -145,8 +171,23 @@ class RobotModel:
         descriptions mount their base with a fixed ``world_joint``."""
         return self.root == "world"
 
+    def reported_frame(self, link_name: str) -> Tuple[str, Pose]:
+        """The simulated link holding ``link_name`` and, in that link's URDF frame, the frame Gazebo reports for
+        ``link_name`` (poses, velocities, sensors, saving)."""
+        holder, offset = self.lumped_into[link_name]
+        own = self.reported_frames.get(link_name)
+        return holder, offset if own is None else compose(offset, own)
+
     def movable_joints(self) -> List[Joint]:
         return [joint for joint in self.joints.values() if joint.movable]
+
+    def free_chain_links(self) -> List[str]:
+        """The Bullet links of the free joints' chains: no links Gazebo has."""
+        return [link for joint in self.joints.values() if joint.free for link, _ in joint.free_chain()]
+
+    def free_chain_joints(self) -> List[str]:
+        """The prismatic Bullet joints of the free joints' chains, to be left without a motor."""
+        return [name for joint in self.joints.values() if joint.free for _, name in joint.free_chain()]
 
     def collision_names(self) -> Dict[str, List[str]]:
         """Simulated link -> the names sdformat gives the collisions it holds: "L_collision" (then
@@ -520,7 +561,7 @@ def _drop_massless_moving_links(links, joints, source) -> List[str]:
     """Gazebo does not model a massless link on a moving joint; it drops it with its whole subtree."""
     dropped: List[str] = []
     for joint in list(joints.values()):
-        if joint.name not in joints or not joint.movable or links[joint.child].has_inertial:
+        if joint.name not in joints or joint.type == "fixed" or links[joint.child].has_inertial:
             continue
         subtree = _subtree(joint.child, joints)
         warn_once(_logger, f"{source}: link '{joint.child}' has no <inertial> but moves on joint '{joint.name}'; like "
@@ -682,12 +723,29 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
     for joint in joints.values():
         if joint.type == "fixed" or joint.child in dropped:
             continue
-        element = copy.deepcopy(next(e for e in checked.findall("joint") if e.get("name") == joint.name))
         holder, offset = lumped_into[joint.parent]
+        if joint.free:
+            _add_free_chain(robot, joint, holder, compose(offset, joint.origin))
+            continue
+        element = copy.deepcopy(next(e for e in checked.findall("joint") if e.get("name") == joint.name))
         element.find("parent").set("link", holder)
         _move(element, offset, document)
         robot.append(element)
     return ElementTree.tostring(robot, encoding="unicode")
+
+
+def _add_free_chain(robot: ElementTree.Element, joint: Joint, holder: str, origin: Pose):
+    """A planar or floating joint as a chain that holds nothing: prismatic x, y, z (no motor, see the engine)
+    and a spherical joint between massless links, so the child moves as the free link sdformat makes it."""
+    parent = holder
+    for (link, prismatic), (_, axis) in zip(joint.free_chain(), FREE_CHAIN_AXES):
+        _add_inertial(ElementTree.SubElement(robot, "link", name=link), [])
+        element = _add_joint(robot, prismatic, "prismatic", parent, link, origin if parent == holder else IDENTITY)
+        ElementTree.SubElement(element, "axis", xyz=axis)
+        ElementTree.SubElement(element, "limit", lower=repr(-_FREE_CHAIN_REACH), upper=repr(_FREE_CHAIN_REACH),
+                               effort="0", velocity="0")
+        parent = link
+    _add_joint(robot, joint.name, "spherical", parent, joint.child, IDENTITY)
 
 
 def _move(element: ElementTree.Element, offset: Pose, document: XmlDocument):
@@ -705,11 +763,13 @@ def _set_origin(element: ElementTree.Element, pose: Pose):
     element.insert(0, origin)
 
 
-def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, child: str, origin: Pose):
+def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, child: str,
+               origin: Pose) -> ElementTree.Element:
     joint = ElementTree.SubElement(robot, "joint", name=name, type=kind)
     ElementTree.SubElement(joint, "parent", link=parent)
     ElementTree.SubElement(joint, "child", link=child)
     _set_origin(joint, origin)
+    return joint
 
 
 def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocument] = None):

@@ -2,7 +2,8 @@
 
 gazebo_ros accepts ``<sdf><model>`` (spawn_model -file/-param) and ``<sdf><world><include>`` (what
 spawn_model -database sends). The model is renamed to the requested name and placed at the requested pose
-composed with its own, as spawn_sdf_model does.
+composed with its own, as spawn_sdf_model does; a ``robot_namespace`` goes into every plugin without a
+``<robotNamespace>``, sensor plugins included, as gazebo_ros does for SDF and URDF alike.
 """
 from xml.etree import ElementTree
 
@@ -22,7 +23,7 @@ def _set_pose(element: ElementTree.Element, pose: Pose):
     existing.text = _pose_text(pose)
 
 
-def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
+def spawn_world_xml(model_xml: str, name: str, pose: Pose, robot_namespace: str = "") -> str:
     where = f"model '{name}'"
     document = parse_xml(model_xml.encode(), where, ModelError)
     root = document.root
@@ -41,6 +42,10 @@ def spawn_world_xml(model_xml: str, name: str, pose: Pose) -> str:
             name_element = ElementTree.SubElement(entry, "name")
         name_element.text = name
     _set_pose(entry, compose(pose, read_pose(entry.find("pose"), document)))
+    if robot_namespace:
+        for plugin in entry.iter("plugin"):
+            if plugin.find("robotNamespace") is None:
+                ElementTree.SubElement(plugin, "robotNamespace").text = robot_namespace
     spawned = ElementTree.Element("sdf", version=root.get("version", "1.6"))
     ElementTree.SubElement(spawned, "world", name="spawn").append(entry)
     return ElementTree.tostring(spawned, encoding="unicode")

@@ -2,10 +2,12 @@
 
 ``parse_world`` is plain XML work (sdformat 1.4 to 1.7): physics, gravity, models inline or through
 ``<include>``, links, collisions, friction, poses composed world_T_model · model_T_link · link_T_collision.
-The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns it into PyBullet
-bodies. Visuals, lights, scene and GUI are left out; physics-relevant elements that are not simulated
-(joints, plugins, unknown geometry) warn once each, naming file and line.
+The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns its rigid models into
+PyBullet bodies; a model with joints, sensors or plugins is read as a robot instead (``sdf_model``), which the
+simulation spawns as URDF robots are. Visuals, lights, scene and GUI are left out; physics-relevant elements
+that are not simulated (world plugins, unknown geometry) warn once each, naming file and line.
 """
+import dataclasses
 import os
 import xml.etree.ElementTree as ET
 from typing import List, NamedTuple, Optional, Sequence, Tuple
@@ -14,11 +16,13 @@ import numpy as np
 
 from ..errors import ModelError, WorldError
 from ..geometry import IDENTITY, Pose, compose
+from ..joints.model_configuration import requested_positions
 from ..log import get_logger, warn_once
 from .materials import sdf_material_rgba
 from .mesh import TriangleMesh, load_mesh
 from .model_path import MODEL_MANIFESTS, default_model_path, find_model_directory
-from .world_description import (SHAPE_KINDS, LinkDescription, ModelDescription, PhysicsConfig, Shape,
+from .sdf_model import ModelLevel, SdfToUrdf, is_articulated, state_joint_positions
+from .world_description import (SHAPE_KINDS, ArticulatedModel, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
 from ..xml_values import (XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute, read_number,
                           read_pose, read_text, read_vector, read_xml_file)
@@ -46,7 +50,8 @@ _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "g
                   "spherical_coordinates", "state", "frame", "road"}
 _WORLD_UNSUPPORTED = {"actor", "population", "plugin"}
 _MODEL_IGNORED = {"static", "pose", "self_collide", "allow_auto_disable", "enable_wind", "frame"}
-_MODEL_UNSUPPORTED = {"joint", "plugin", "gripper"}
+_MODEL_UNSUPPORTED = {"gripper"}
+_MODEL_ARTICULATION = {"joint", "plugin"}  # such a model is simulated as a robot (sdf_model)
 _LINK_IGNORED = {"pose", "inertial", "visual", "sensor", "self_collide", "enable_wind", "must_be_base_link",
                  "velocity_decay", "frame", "projector", "audio_sink", "audio_source", "battery", "light",
                  "particle_emitter"}
@@ -159,9 +164,15 @@ class _WorldParser:
                 continue
             unique[entry.name] = entry
             scope.add(entry.name, entry.pose, entry.pose_document)
-        models = tuple(self._model(entry, scope) for entry in unique.values())
-        return WorldDescription(world.get("name", "default"), path, self._physics(document, world), models,
-                                tuple(others))
+        models = [self._model(entry, scope) for entry in unique.values()]
+        state = world.find("state")
+        if state is not None:
+            models = [_with_state(model, state, document) if isinstance(model, ArticulatedModel) else model
+                      for model in models]
+        return WorldDescription(world.get("name", "default"), path, self._physics(document, world),
+                                tuple(model for model in models if isinstance(model, ModelDescription)),
+                                tuple(others),
+                                tuple(model for model in models if isinstance(model, ArticulatedModel)))
 
     # Files ---------------------------------------------------------------------------------------------
 
@@ -262,18 +273,28 @@ class _WorldParser:
                             None if static is None else read_bool(static, document), document.where(include),
                             include)]
 
-    def _model(self, entry: _ModelEntry, parent: _Frames) -> ModelDescription:
+    def _model(self, entry: _ModelEntry, parent: _Frames):
+        """A ModelDescription (a rigid model), or an ArticulatedModel for one with joints, sensors or plugins."""
         static = entry.static
         if static is None:
             static = read_bool(entry.element.find("static"), entry.document, default=False)
         scope = _Frames(f"model '{entry.name}'", parent.frame(entry.name, entry.document, entry.element),
                         ("", "__model__"))
-        links = self._links(entry, scope, static, entry.name, prefix="", expanding=(entry.element,))
+        levels = self._levels(entry, scope, prefix="", expanding=(entry.element,))
+        # SDF 1.6 lets an <include> add plugins to the model it includes.
+        added_plugins = entry.source.findall("plugin") if entry.source.tag == "include" else []
+        if is_articulated(levels) or added_plugins:
+            converted = SdfToUrdf(entry.name, entry.where, scope.origin, static, levels, self._mesh_path,
+                                  self._inertial, self._check_link, added_plugins).build()
+            return ArticulatedModel(entry.name, static, scope.origin, converted.robot, converted.root_in_model,
+                                    entry.source)
+        links = [self._link(link, level.document, level.frames, static, entry.name, level.prefix)
+                 for level in levels for link in level.element.findall("link")]
         return ModelDescription(entry.name, static, scope.origin, tuple(links), entry.source)
 
-    def _links(self, entry: _ModelEntry, scope: _Frames, static: bool, model: str, prefix: str,
-               expanding: Tuple[ET.Element, ...]) -> List[LinkDescription]:
-        """Links of a model and of the models nested in it, flattened; ``expanding`` are the <model>s on the way
+    def _levels(self, entry: _ModelEntry, scope: _Frames, prefix: str,
+                expanding: Tuple[ET.Element, ...]) -> List[ModelLevel]:
+        """A model and the models nested in it, with their frames; ``expanding`` are the <model>s on the way
         (an included file is read once, so including a model inside itself meets the same element again)."""
         element, document = entry.element, entry.document
         nested = []
@@ -287,22 +308,22 @@ class _WorldParser:
                 nested.extend(self._include(child, document))
             elif child.tag in _MODEL_UNSUPPORTED:
                 self._warn_unsupported(document, child)
-            elif child.tag not in _MODEL_IGNORED:
+            elif child.tag not in _MODEL_IGNORED and child.tag not in _MODEL_ARTICULATION:
                 self._warn_unknown(document, child, "model")
         for inner in nested:
             scope.add(inner.name, inner.pose, inner.pose_document)
-        links = [self._link(link, document, scope, static, model, prefix) for link in element.findall("link")]
+        levels = [ModelLevel(element, document, scope, prefix)]
         for inner in nested:
             if inner.element in expanding:
                 raise WorldError(f"{inner.where}: {inner.document.path} includes itself")
             inner_scope = _Frames(f"model '{inner.name}'", scope.frame(inner.name, document, inner.element),
                                   ("", "__model__"))
-            links += self._links(inner, inner_scope, static, model, f"{prefix}{inner.name}::",
-                                 expanding + (inner.element,))
-        return links
+            levels += self._levels(inner, inner_scope, f"{prefix}{inner.name}::", expanding + (inner.element,))
+        return levels
 
-    def _link(self, link: ET.Element, document: XmlDocument, scope: _Frames, static: bool, model: str,
-              prefix: str) -> LinkDescription:
+    @classmethod
+    def _check_link(cls, link: ET.Element, document: XmlDocument, model: str) -> None:
+        """Warn once for what a link has that is not simulated (both for rigid models and those with joints)."""
         name = link.get("name", "")
         for tag, required in _LINK_DEFAULTS_REQUIRED.items():
             if read_bool(link.find(tag), document, default=required) != required:
@@ -310,7 +331,12 @@ class _WorldParser:
                                 f"in link '{name}' of model '{model}' is not simulated")
         for child in link:
             if child.tag not in _LINK_IGNORED and child.tag not in _LINK_DEFAULTS_REQUIRED and child.tag != "collision":
-                self._warn_unknown(document, child, "link")
+                cls._warn_unknown(document, child, "link")
+
+    def _link(self, link: ET.Element, document: XmlDocument, scope: _Frames, static: bool, model: str,
+              prefix: str) -> LinkDescription:
+        name = link.get("name", "")
+        self._check_link(link, document, model)
         pose = scope.frame(name, document, link)
         mass, inertia, inertial_pose = self._inertial(link.find("inertial"), document, static,
                                                       f"link '{name}' of model '{model}'")
@@ -443,8 +469,7 @@ class _WorldParser:
         what = f"<{element.tag}" + (f" name='{element.get('name')}'" if element.get("name") else "") + ">"
         if element.get("filename"):
             what += f" ({element.get('filename')})"
-        effect = "the model's links move as one rigid body" if element.tag == "joint" else "ignored"
-        warn_once(_log, f"{document.where(element)}: {what} is not simulated; {effect}")
+        warn_once(_log, f"{document.where(element)}: {what} is not simulated; ignored")
 
     @staticmethod
     def _warn_unknown(document: XmlDocument, element: ET.Element, parent: str) -> None:
@@ -452,6 +477,23 @@ class _WorldParser:
 
 
 # --- Values -------------------------------------------------------------------------------------------------
+
+def _with_state(model: ArticulatedModel, state: ET.Element, document: XmlDocument) -> ArticulatedModel:
+    """A model with joints whose joints start where the world's <state> (a saved world) puts its links; a state
+    that cannot be reached (beyond a limit, a bad pose) is said once and the model starts as its file has it."""
+    found = next((element for element in state.findall("model") if element.get("name") == model.name), None)
+    if found is None:
+        return model
+    try:
+        positions = state_joint_positions(found, document, model.pose, model.robot)
+        requested_positions(model.robot.joints, [joint.name for joint in model.robot.movable_joints()],
+                            list(positions), list(positions.values()))
+    except (ModelError, WorldError) as error:
+        warn_once(_log, f"{document.where(found)}: <state> of model '{model.name}' left out ({error}); its joints "
+                        "start where its model puts them")
+        return model
+    return dataclasses.replace(model, joint_positions=positions)
+
 
 def _version(text: str) -> Tuple[int, ...]:
     try:

@@ -5,12 +5,13 @@ scene draws them, ``world_writer`` writes them back as SDF.
 """
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import Dict, Optional, Tuple
 
 import numpy as np
 
 from ..geometry import Pose, rotation_matrix
 from .mesh import TriangleMesh
+from .robot_model import RobotModel
 
 SHAPE_KINDS = ("box", "cylinder", "sphere", "plane", "mesh")
 
@@ -107,6 +108,19 @@ class ModelDescription:
 
 
 @dataclass(frozen=True)
+class ArticulatedModel:
+    """A model with joints, sensors or plugins, simulated as a robot from the URDF it reads as (``sdf_model``)."""
+    name: str
+    static: bool
+    pose: Pose  # world frame, as loaded
+    robot: RobotModel
+    root_in_model: Pose  # the robot's root link frame in the model frame
+    source: Optional[ET.Element] = field(default=None, compare=False, repr=False)
+    # Where the world's <state> (a saved world) puts its one-axis joints: set once it is spawned.
+    joint_positions: Dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
 class WorldDescription:
     name: str
     path: str
@@ -114,6 +128,7 @@ class WorldDescription:
     models: Tuple[ModelDescription, ...]
     # World children other than models, physics, gravity and frames (lights, scene, gui...), kept for saving.
     others: Tuple[ET.Element, ...] = field(default=(), compare=False, repr=False)
+    robots: Tuple[ArticulatedModel, ...] = ()
 
     @property
     def shapes(self) -> Tuple[Shape, ...]:

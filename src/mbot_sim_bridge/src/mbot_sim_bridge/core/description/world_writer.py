@@ -2,7 +2,10 @@
 
 Every world model is written back the way it was read, at its pose now: an ``<include>`` stays an include of
 the same ``<uri>`` with ``<name>`` and ``<pose>`` set; an inline ``<model>`` stays inline with its own links,
-whose poses in the model frame do not change (SDF joints are not simulated, so a model moves as one body).
+whose poses in the model frame do not change. A model with joints is written as read, and where its joints
+stand now goes, as Gazebo saves it, into the world's ``<state>``: the world pose of each of its links (SDF has
+no joint position in a model, and Gazebo's ModelState writes links only); reading the file sets the joints
+from those poses.
 Lights, scene and the other non-model world elements are copied; physics and gravity come from the
 settings in use. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
 converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
@@ -15,12 +18,12 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
+from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence, Union
 
 from ..errors import WorldError
 from ..geometry import Pose, compose, inverse, rpy
-from .robot_model import RobotModel
-from .world_description import ModelDescription, PhysicsConfig, WorldDescription
+from .robot_model import BALL_JOINT_TYPE, RobotModel
+from .world_description import ArticulatedModel, ModelDescription, PhysicsConfig, WorldDescription
 
 SDF_VERSION = "1.6"
 # Frame semantics that came with 1.7; a copied model that uses them makes the file 1.7 (Gazebo 11 reads both).
@@ -39,10 +42,12 @@ class SavedRobot:
 
 
 class WorldSnapshot(NamedTuple):
-    models: List[ModelDescription]  # world models (the world file's and spawn_sdf_model's), in load order
+    # world models (the world file's and spawn_sdf_model's, those with joints too), in load order
+    models: List[Union[ModelDescription, ArticulatedModel]]
     poses: Dict[str, Pose]  # model name -> world pose of its model frame now
     robots: List[SavedRobot]  # URDF robots, with the world pose of every URDF link now (when asked for)
-    robot_names: List[str]  # every URDF robot, written or not
+    robot_names: List[str]  # every robot spawned from URDF, written or not
+    link_states: Dict[str, Dict[str, Pose]]  # model with joints -> world pose of each of its links now
 
 
 def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
@@ -50,13 +55,22 @@ def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
     engine = simulation.engine
     models = [model for name, model in simulation.world_models.items() if name in engine.model_names()]
     poses = {model.name: engine.model_pose(model.name) for model in models}
+    # SDF models with joints run as robots; they are written back as read, at their model frame's pose now.
+    link_states = {}
+    for name, articulated in simulation.sdf_robots.items():
+        models.append(articulated)
+        poses[name] = compose(engine.model_pose(name), inverse(articulated.root_in_model))
+        robot = simulation.models[name].robot
+        link_states[name] = {link: robot.link_world_pose(link) for link in robot.model.lumped_into if link != "world"}
+    urdf_robots = [name for name in simulation.models if name not in simulation.sdf_robots]
     robots = []
     if with_robots:
-        for name, spawned in simulation.models.items():
+        for name in urdf_robots:
+            spawned = simulation.models[name]
             robot = spawned.robot
             links = {link: robot.link_world_pose(link) for link in robot.model.lumped_into}
             robots.append(SavedRobot(name, robot.model, links))
-    return WorldSnapshot(models, poses, robots, list(simulation.models))
+    return WorldSnapshot(models, poses, robots, urdf_robots, link_states)
 
 
 def pose_text(pose: Pose) -> str:
@@ -71,16 +85,18 @@ def _number(value: float) -> str:
     return "0" if text == "-0" else text
 
 
-def world_sdf(world: WorldDescription, models: Sequence[ModelDescription], poses: Mapping[str, Pose],
-              robots: Sequence[SavedRobot] = ()) -> str:
-    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world) and ``robots``."""
+def world_sdf(world: WorldDescription, models: Sequence[Union[ModelDescription, ArticulatedModel]],
+              poses: Mapping[str, Pose], robots: Sequence[SavedRobot] = (),
+              link_states: Optional[Mapping[str, Mapping[str, Pose]]] = None) -> str:
+    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world), ``robots``, and
+    ``link_states`` (world link poses of models with joints) as a ``<state>``."""
     root = ET.Element("sdf", version=SDF_VERSION)
     element = ET.SubElement(root, "world", name=world.name)
     for other in world.others:
         element.append(copy.deepcopy(other))
     _physics(element, world.physics)
     base = os.path.dirname(os.path.abspath(world.path))
-    main_models = {id(model) for model in world.models}
+    main_models = {id(model) for model in world.models + world.robots}
     for model in models:
         if model.name not in poses:
             raise WorldError(f"no current pose for model '{model.name}'")
@@ -88,10 +104,29 @@ def world_sdf(world: WorldDescription, models: Sequence[ModelDescription], poses
         element.append(_model_element(model, poses[model.name], base if id(model) in main_models else None))
     for robot in robots:
         element.append(robot_model_element(robot))
+    if link_states:
+        element.append(_state(world.name, poses, link_states))
     if any(item.get(attribute) is not None for item in root.iter() for attribute in _SDF_1_7_ATTRIBUTES):
         root.set("version", "1.7")
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _state(world_name: str, poses: Mapping[str, Pose], link_states: Mapping[str, Mapping[str, Pose]]) -> ET.Element:
+    """Gazebo's ``<state>`` (SDF state.sdf) of the models with joints: model and link world poses; a nested
+    model's links ("inner::link") in a ``<model>`` of their own, as Gazebo's ModelState nests them."""
+    state = ET.Element("state", world_name=world_name)
+    for name, links in link_states.items():
+        model = ET.SubElement(state, "model", name=name)
+        ET.SubElement(model, "pose").text = pose_text(poses[name])
+        for link, pose in links.items():
+            parent = model
+            *scopes, local = link.split("::")
+            for scope in scopes:
+                nested = parent.find(f"model[@name='{scope}']")
+                parent = nested if nested is not None else ET.SubElement(parent, "model", name=scope)
+            ET.SubElement(ET.SubElement(parent, "link", name=local), "pose").text = pose_text(pose)
+    return state
 
 
 def _physics(world: ET.Element, physics: PhysicsConfig):
@@ -105,7 +140,7 @@ def _physics(world: ET.Element, physics: PhysicsConfig):
         ET.SubElement(constraints, tag).text = _number(getattr(physics, tag))
 
 
-def _model_element(model: ModelDescription, pose: Pose, base: Optional[str]) -> ET.Element:
+def _model_element(model: Union[ModelDescription, ArticulatedModel], pose: Pose, base: Optional[str]) -> ET.Element:
     if model.source is None:
         raise WorldError(f"model '{model.name}' was not read from SDF; it cannot be saved")
     element = copy.deepcopy(model.source)
@@ -158,7 +193,8 @@ def robot_model_element(robot: SavedRobot) -> ET.Element:
         if name in robot.link_poses:
             element.append(_link(link, model, compose(from_model, robot.link_poses[name])))
     for joint in model.joints.values():
-        if joint.parent in robot.link_poses and joint.child in robot.link_poses:
+        # A planar or floating joint is none in Gazebo: its child is a free link of the model.
+        if joint.parent in robot.link_poses and joint.child in robot.link_poses and not joint.free:
             element.append(_joint(joint))
     for plugin in model.plugins:
         element.append(copy.deepcopy(plugin))
@@ -247,7 +283,7 @@ def _visual_material(visual: ET.Element, urdf_material: Optional[ET.Element], ga
 
 
 def _joint(joint) -> ET.Element:
-    kind = "revolute" if joint.type == "continuous" else joint.type
+    kind = {"continuous": "revolute", BALL_JOINT_TYPE: "ball"}.get(joint.type, joint.type)
     element = ET.Element("joint", name=joint.name, type=kind)
     ET.SubElement(element, "parent").text = joint.parent
     ET.SubElement(element, "child").text = joint.child

@@ -93,7 +93,7 @@ class Bumper(Plugin):
         else:
             centre = client.getLinkState(robot.body, self.link_index)[0]
         centre = np.asarray(centre)
-        link_pose = robot.link_world_pose(self.link)
+        link_pose = robot.body_link_pose(self.link)  # the frame collision_boxes are given in
         pairs = {}
         points = [point for index in robot.bullet_links(self.link)
                   for point in client.getContactPoints(bodyA=robot.body, linkIndexA=index)]

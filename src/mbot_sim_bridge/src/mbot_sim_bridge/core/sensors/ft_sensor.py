@@ -106,7 +106,7 @@ class FTSensor(Plugin):
             linear, angular = ((current - before) / elapsed for current, before in zip(velocities, self._previous[1:]))
         self._previous = (now, *velocities)
         omegas = velocities[1]
-        joint_origin = np.asarray(robot.link_world_pose(self.child_link).position)
+        joint_origin = np.asarray(robot.body_link_pose(self.child_link).position)  # the URDF frame: the joint's
         inertial = self.masses[:, np.newaxis] * (linear - self.gravity)
         force = inertial.sum(axis=0)
         torque = np.cross(centres - joint_origin, inertial).sum(axis=0)
