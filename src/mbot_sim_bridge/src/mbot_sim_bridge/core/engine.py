@@ -52,6 +52,15 @@ MAX_WHEEL_MU = 1.0e3
 MAX_BODY_LINKS = 128
 
 
+class StepFault(Exception):
+    """Engine.step failed in the work it does for one model (its wheel contacts, the correction of its placement):
+    the simulation contains it to ``model``. What Bullet's own step raises is not one model's and comes as is."""
+
+    def __init__(self, model: str, part: str, error: Exception):
+        super().__init__(f"{part}: {type(error).__name__}: {error}")
+        self.model = model
+
+
 class CachingBulletClient(BulletClient):
     """A BulletClient that binds each PyBullet function to its client once: BulletClient builds a new
     functools.partial on every attribute access, a few per cent of the bridge's loop."""
@@ -302,7 +311,6 @@ class Engine:
         # steps since its last deep contact]; see _bound_correction.
         self._settling: Dict[int, List[int]] = {}
         self._wheels: Dict[int, WheelContacts] = {}  # per body, the friction of its wheels (wheel_contact)
-        self._before_step: List[Callable[[], None]] = []
 
     def _configure(self):
         self.client.setTimeStep(self.physics.max_step_size)
@@ -335,7 +343,6 @@ class Engine:
         self._root_from_com.clear()
         self._settling.clear()
         self._wheels.clear()
-        self._before_step = []
 
     @property
     def sim_time(self) -> float:
@@ -344,22 +351,23 @@ class Engine:
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
         """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of
         ``after_each`` (recorders of per-step state, then the plugins that act on every step) is called after
-        every one, with ``sim_time`` already that step's."""
+        every one, with ``sim_time`` already that step's. ``steps`` counts each step as it is taken, so after a
+        failure it holds the steps done; StepFault names the model whose part of the step raised."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
-        before = self._before_step
+        wheels = self._apply_wheels if self._wheels else None
         while self._settling and count > 0:
-            for call in before:
-                call()
+            if wheels is not None:
+                wheels()
             step()
             self.steps += 1
             count -= 1
             self._bound_correction()
             for call in after_each:
                 call()
-        if after_each or before:
+        if after_each or wheels is not None:
             for _ in range(count):
-                for call in before:
-                    call()
+                if wheels is not None:
+                    wheels()
                 step()
                 self.steps += 1
                 for call in after_each:
@@ -367,7 +375,14 @@ class Engine:
         else:
             for _ in range(count):
                 step()
-            self.steps += count
+                self.steps += 1
+
+    def _apply_wheels(self):
+        for body, wheels in self._wheels.items():
+            try:
+                wheels.apply()
+            except Exception as error:  # one robot's wheel arithmetic; its model is contained by the caller
+                raise StepFault(self._name_of(body), "wheel contacts", error) from error
 
     def add_world(self, world: LoadedWorld):
         """Register the bodies a world loader built, so reset and model queries know them."""
@@ -513,17 +528,20 @@ class Engine:
         for body, counts in list(self._settling.items()):
             counts[0] += 1
             counts[1] += 1
-            for point in client.getContactPoints(bodyA=body):
-                if -point[8] <= deep:
-                    continue
-                counts[1] = 0
-                body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
-                velocity_a = self._point_velocity(body_a, link_a, on_a)
-                velocity_b = self._point_velocity(body_b, link_b, on_b)
-                speed = math.dist(velocity_a, velocity_b)
-                if speed > cap:
-                    for moved in (body_a, body_b):
-                        scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            try:
+                for point in client.getContactPoints(bodyA=body):
+                    if -point[8] <= deep:
+                        continue
+                    counts[1] = 0
+                    body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
+                    velocity_a = self._point_velocity(body_a, link_a, on_a)
+                    velocity_b = self._point_velocity(body_b, link_b, on_b)
+                    speed = math.dist(velocity_a, velocity_b)
+                    if speed > cap:
+                        for moved in (body_a, body_b):
+                            scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            except Exception as error:  # one placed body's arithmetic; its model is contained by the caller
+                raise StepFault(self._name_of(body), "placement correction", error) from error
             if counts[1] >= settled_after:
                 del self._settling[body]
             elif counts[0] == round(SETTLING_WARNING / physics.max_step_size):
@@ -666,7 +684,6 @@ class Engine:
             self._wheels.pop(body, None)
         else:
             self._wheels[body] = contacts
-        self._before_step = [wheels.apply for wheels in self._wheels.values()]
 
     def _set_surface(self, robot: SpawnedRobot, link_name: str, index: int, caster: bool, modelled: bool):
         mu1, mu2 = robot.model.bullet_surface(link_name, f"model '{robot.name}'")
