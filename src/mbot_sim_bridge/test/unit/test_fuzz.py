@@ -444,7 +444,7 @@ def _second_parent(root):
     (lambda root: root.find("link[@name='base_link']/inertial/inertia").set("ixx", "-1"),
      "link 'base_link': <inertia ixx>: -1 is outside the valid range >= 0"),
     (lambda root: root.find("link[@name='base_link']/inertial/mass").set("value", "1e300"),
-     "link 'base_link': <mass value>: 1e+300 is outside the valid range >= 0 and <= 1e+09"),
+     "link 'base_link': <mass value>: 1e+300 is outside the valid range 0 or >= 1e-06 and <= 1e+09"),
     # 36 million rays per scan took the machine's memory.
     (lambda root: setattr(root.find(".//sensor/ray/scan/horizontal/resolution"), "text", "1e5"),
      "3.6e+07 ranges per scan; at most 262144 are simulated"),
