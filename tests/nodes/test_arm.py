@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """The arm as arm_bringup.launch brings it up: a two-point FollowJointTrajectory goal succeeds with every joint
 within 0.01 rad (joint_states); a path tolerance the arm cannot keep aborts with PATH_TOLERANCE_VIOLATED; a second
-goal preempts the first; unknown joints are rejected with INVALID_JOINTS; the command topic moves the arm without
-the action; state and query_state report the trajectory; an elbow commanded past its limit stops at it; the
-gripper opens to its goal (reached_goal), closes on a box and stalls there, its mimic finger within 0.001 of the
-leader; goals past the finger's travel each get a result; a switch_controller pending while physics is paused is
-answered when the arm is deleted, and /clock runs on."""
-import threading
+goal preempts the first; unknown or repeated joints are rejected with INVALID_JOINTS and a reason; the command
+topic moves the arm without the action; state and query_state report the trajectory; an elbow commanded past its
+limit stops at it; the gripper opens to its goal (reached_goal), closes on a box and stalls there, its mimic finger
+within 0.001 of the leader; goals past the finger's travel each get a result; a switch_controller pending while
+physics is paused is answered when the arm is deleted, and /clock runs on."""
 import math
+import threading
 import unittest
 
 import actionlib
@@ -148,6 +148,13 @@ class Arm(unittest.TestCase):
         self.trajectory_clients[0].send_goal(goal)
         state, result = self.result()
         self.assertEqual((state, result.error_code), (GoalStatus.REJECTED, FollowJointTrajectoryResult.INVALID_JOINTS))
+        self.assertIn("wrist_4_joint", result.error_string)
+        # One joint named six times: rejected too (upstream's mapping would accept it and move one joint).
+        goal.trajectory.joint_names = [JOINTS[0]] * 6
+        self.trajectory_clients[0].send_goal(goal)
+        state, result = self.result()
+        self.assertEqual((state, result.error_code), (GoalStatus.REJECTED, FollowJointTrajectoryResult.INVALID_JOINTS))
+        self.figures.append(f"a goal naming {JOINTS[0]} six times: REJECTED INVALID_JOINTS, '{result.error_string}'")
 
     def test_05_the_command_topic_moves_the_arm_without_the_action(self):
         target = [-0.3, 0.4, 0.5, 0.2, -0.3, 0.1]
