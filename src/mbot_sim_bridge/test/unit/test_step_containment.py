@@ -55,7 +55,8 @@ class DriveWithFailingRecorder(DiffDrive):
 
 
 def test_a_plugin_whose_recorder_raises_is_disabled_and_the_rest_runs(mbot_urdf, tmp_path, caplog):
-    registry = {**CORE_PLUGINS, "libgazebo_ros_diff_drive.so": DriveWithFailingRecorder}
+    registry = {filename: DriveWithFailingRecorder if plugin_class is DiffDrive else plugin_class
+                for filename, plugin_class in CORE_PLUGINS.items()}
     sim, resting = mbot_with_crate(mbot_urdf, tmp_path, registry)
     try:
         assert not any(isinstance(plugin, DiffDrive) for plugin in sim.models["mbot"].plugins)

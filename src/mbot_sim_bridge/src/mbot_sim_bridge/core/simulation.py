@@ -6,7 +6,6 @@ tests run the same ``advance`` with the plugins' core classes. Plugins are built
 (Gazebo file name -> class) handed in: the plugin table's core classes (``plugin_table.CORE_PLUGINS``) or the
 ROS layer's registry derived from it, so the core never imports the ROS plugin layer.
 """
-import functools
 import hashlib
 import sys
 from dataclasses import replace
@@ -327,8 +326,7 @@ class Simulation:
     def _schedule(self):
         self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
                          for plugin in spawned.plugins]
-        self._every_step_calls = [self._every_step_call(plugin, functools.partial(plugin.on_step, self.step_size))
-                                  for plugin in self._plugins if plugin.needs_every_step]
+        self._every_step_calls = [self._every_step_call(plugin) for plugin in self._plugins if plugin.needs_every_step]
         self._recording = [plugin for plugin in self._plugins if type(plugin).step_recorder is not Plugin.step_recorder]
 
     # -- stepping ------------------------------------------------------------------------------------------------
@@ -414,16 +412,20 @@ class Simulation:
         while count > 0:
             count -= self.advance(count, before_updates)
 
-    def _every_step_call(self, plugin: Plugin, call: Callable[[], None]) -> Callable[[], None]:
-        """``call`` (``plugin.on_step`` or its recorder) for ``Engine.step`` to make after every step of a batch;
-        after a failure (the plugin is then disabled) the rest of the batch skips it."""
-        model = plugin.context.model
+    def _every_step_call(self, plugin: Plugin, recorder: Optional[Callable[[], None]] = None) -> Callable[[], None]:
+        """``plugin.on_step`` (or ``recorder``, what its step_recorder returned) as a call for ``Engine.step`` to
+        make after every step of a batch; after a failure (the plugin is then disabled) the rest of the batch skips
+        it."""
+        step_size, model = self.step_size, plugin.context.model
 
         def guarded():
             if plugin in model.plugins:  # a failed plugin is removed from its model's few
                 # _guarded written out: this runs after every physics step, where each extra call costs
                 try:
-                    call()
+                    if recorder is None:
+                        plugin.on_step(step_size)
+                    else:
+                        recorder()
                 except Exception as error:  # the plugin boundary, as in _guarded
                     self._disable(plugin, error)
         return guarded
