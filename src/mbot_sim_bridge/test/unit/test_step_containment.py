@@ -1,6 +1,7 @@
 """What raises inside the physics step or a rebuild is contained: a plugin's per-step recorder, one model's part of
-``Engine.step``, Bullet's own step, a model that cannot be built again on reset_simulation. That model (or
-plugin) is frozen or removed with one error, the others keep their poses and the loop keeps stepping."""
+``Engine.step`` (its wheel contacts, the correction of its placement), Bullet's own step, a model that cannot be
+built again on reset_simulation. That model (or plugin) is frozen or removed with one error, the others keep their
+poses and the loop keeps stepping."""
 import logging
 import math
 import os
@@ -98,6 +99,29 @@ def test_a_model_whose_part_of_the_step_raises_is_frozen_and_reset_brings_it_bac
         drive.set_command(0.3, 0.0)
         sim.step(500)
         assert sim.engine.model_pose("mbot").position[0] > 0.05, "reset_world ends the freeze"
+        assert_crate_still(sim, resting)
+    finally:
+        sim.close()
+
+
+def test_a_model_whose_placement_correction_raises_is_frozen(mbot_urdf, tmp_path, caplog):
+    """The correction of a body placed into another (see Engine._bound_correction) is that body's part of the step."""
+    sim, resting = mbot_with_crate(mbot_urdf, tmp_path)
+    try:
+        point_velocity, failures = sim.engine._point_velocity, []
+
+        def failing_once(*arguments):
+            if not failures:
+                failures.append(arguments)
+                raise ValueError("math domain error")
+            return point_velocity(*arguments)
+        sim.engine._point_velocity = failing_once
+        sim.set_model_state("mbot", pose_from_xyz_rpy((0, 0, -0.05), (0, 0, 0)))  # 5 cm into the ground
+        sim.step(100)
+        said = errors(caplog, "model 'mbot': its part of the physics step failed (placement correction: ValueError",
+                      "frozen")
+        assert failures and len(said) == 1 and len(errors(caplog)) == 1, [r.getMessage() for r in caplog.records]
+        assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01, "frozen at its spawn pose"
         assert_crate_still(sim, resting)
     finally:
         sim.close()
