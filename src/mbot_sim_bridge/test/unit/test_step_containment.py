@@ -5,6 +5,7 @@ poses and the loop keeps stepping."""
 import logging
 import math
 import os
+from types import SimpleNamespace
 
 import numpy as np
 import pybullet
@@ -21,6 +22,7 @@ from mbot_sim_bridge.core.simulation import Simulation
 
 WORLDS = os.path.join(os.path.dirname(__file__), "..", "..", "..", "..", "worlds")
 BYSTANDER_TOLERANCE = 1e-4  # m
+DIVISION_BY_ZERO = ZeroDivisionError("float division by zero")  # what the injected faults raise
 CRATE = """<sdf version="1.6"><model name="crate"><link name="link">
   <inertial><mass>1</mass><inertia><ixx>0.04</ixx><iyy>0.04</iyy><izz>0.04</izz></inertia></inertial>
   <collision name="c"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision></link></model></sdf>"""
@@ -46,12 +48,24 @@ def assert_crate_still(sim, resting):
     assert math.dist(sim.engine.model_pose("crate").position, resting) < BYSTANDER_TOLERANCE
 
 
+def failing_once(function, error):
+    """``function`` raising ``error`` at its first call, and the list that records that call."""
+    failures = []
+
+    def call(*arguments):
+        if not failures:
+            failures.append(arguments)
+            raise error
+        return function(*arguments)
+    return call, failures
+
+
 class DriveWithFailingRecorder(DiffDrive):
     """A diff drive whose per-step recorder (as the IMU's) raises: recorders run inside Engine.step."""
 
     def step_recorder(self, now):
         def record():
-            raise ZeroDivisionError("float division by zero")
+            raise DIVISION_BY_ZERO
         return record
 
 
@@ -70,28 +84,31 @@ def test_a_plugin_whose_recorder_raises_is_disabled_and_the_rest_runs(mbot_urdf,
         sim.close()
 
 
-class FailingWheels:
-    """Stands for a robot's wheel contacts whose arithmetic raises once (Engine.step applies them every step)."""
-
-    def __init__(self):
-        self.calls = 0
-
-    def apply(self):
-        self.calls += 1
-        if self.calls == 5:
-            raise ZeroDivisionError("float division by zero")
+def wheels_fail(sim):
+    """A stand-in for the mbot's wheel contacts whose arithmetic raises (Engine.step applies them every step)."""
+    wheels, _ = failing_once(lambda: None, DIVISION_BY_ZERO)
+    sim.engine._wheels[sim.models["mbot"].robot.body] = SimpleNamespace(apply=wheels)
 
 
-def test_a_model_whose_part_of_the_step_raises_is_frozen_and_reset_brings_it_back(mbot_urdf, tmp_path, caplog):
+def placement_correction_fails(sim):
+    """The correction of a body placed into another (Engine._bound_correction) raising for the mbot, put 5 cm into
+    the ground."""
+    sim.engine._point_velocity, _ = failing_once(sim.engine._point_velocity, DIVISION_BY_ZERO)
+    sim.set_model_state("mbot", pose_from_xyz_rpy((0, 0, -0.05), (0, 0, 0)))
+
+
+@pytest.mark.parametrize("part, fail", [("wheel contacts", wheels_fail),
+                                        ("placement correction", placement_correction_fails)])
+def test_a_model_whose_part_of_the_step_raises_is_frozen_and_reset_brings_it_back(mbot_urdf, tmp_path, caplog, part,
+                                                                                  fail):
     sim, resting = mbot_with_crate(mbot_urdf, tmp_path)
     try:
         drive = next(plugin for plugin in sim.models["mbot"].plugins if isinstance(plugin, DiffDrive))
-        sim.engine._wheels[sim.models["mbot"].robot.body] = FailingWheels()
+        fail(sim)
         drive.set_command(0.3, 0.0)
         sim.step(500)
         assert sim.sim_time == pytest.approx(0.8)
-        said = errors(caplog, "model 'mbot': its part of the physics step failed (wheel contacts: ZeroDivisionError",
-                      "frozen")
+        said = errors(caplog, f"model 'mbot': its part of the physics step failed ({part}: ZeroDivisionError", "frozen")
         assert len(said) == 1 and len(errors(caplog)) == 1, [record.getMessage() for record in caplog.records]
         assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01, "frozen at its spawn pose"
         assert_crate_still(sim, resting)
@@ -104,40 +121,11 @@ def test_a_model_whose_part_of_the_step_raises_is_frozen_and_reset_brings_it_bac
         sim.close()
 
 
-def test_a_model_whose_placement_correction_raises_is_frozen(mbot_urdf, tmp_path, caplog):
-    """The correction of a body placed into another (see Engine._bound_correction) is that body's part of the step."""
-    sim, resting = mbot_with_crate(mbot_urdf, tmp_path)
-    try:
-        point_velocity, failures = sim.engine._point_velocity, []
-
-        def failing_once(*arguments):
-            if not failures:
-                failures.append(arguments)
-                raise ValueError("math domain error")
-            return point_velocity(*arguments)
-        sim.engine._point_velocity = failing_once
-        sim.set_model_state("mbot", pose_from_xyz_rpy((0, 0, -0.05), (0, 0, 0)))  # 5 cm into the ground
-        sim.step(100)
-        said = errors(caplog, "model 'mbot': its part of the physics step failed (placement correction: ValueError",
-                      "frozen")
-        assert failures and len(said) == 1 and len(errors(caplog)) == 1, [r.getMessage() for r in caplog.records]
-        assert math.dist(sim.engine.model_pose("mbot").position, (0, 0, 0)) < 0.01, "frozen at its spawn pose"
-        assert_crate_still(sim, resting)
-    finally:
-        sim.close()
-
-
 def test_bullets_own_step_raising_skips_the_batch_and_the_world_steps_on(mbot_urdf, tmp_path, caplog):
     sim, resting = mbot_with_crate(mbot_urdf, tmp_path)
     try:
-        bullet_step, failures = sim.engine.client.stepSimulation, []
-
-        def step_failing_once():
-            if not failures:
-                failures.append(sim.sim_time)
-                raise pybullet.error("stepSimulation failed.")
-            bullet_step()
-        sim.engine.client.stepSimulation = step_failing_once
+        client = sim.engine.client
+        client.stepSimulation, failures = failing_once(client.stepSimulation, pybullet.error("stepSimulation failed."))
         sim.step(100)
         assert failures and sim.sim_time == pytest.approx(0.4)
         assert len(errors(caplog, "the physics step at 0.300 s failed (error: stepSimulation failed.)")) == 1
