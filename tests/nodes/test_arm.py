@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """The arm as arm_bringup.launch brings it up: a two-point FollowJointTrajectory goal succeeds with every joint
 within 0.01 rad (joint_states); a path tolerance the arm cannot keep aborts with PATH_TOLERANCE_VIOLATED; a second
-goal preempts the first; unknown joints are rejected with INVALID_JOINTS; the command topic moves the arm without
-the action; state and query_state report the trajectory; an elbow commanded past its limit stops at it; the
-gripper opens to its goal (reached_goal), closes on a box and stalls there, its mimic finger within 0.001 of the
-leader."""
+goal preempts the first; unknown or repeated joints are rejected with INVALID_JOINTS and a reason; the command
+topic moves the arm without the action; state and query_state report the trajectory; an elbow commanded past its
+limit stops at it; the gripper opens to its goal (reached_goal), closes on a box and stalls there, its mimic finger
+within 0.001 of the leader; goals past the finger's travel each get a result; a switch_controller pending while
+physics is paused is answered when the arm is deleted, and /clock runs on."""
 import math
+import threading
 import unittest
 
 import actionlib
@@ -16,9 +18,11 @@ from control_msgs.msg import (FollowJointTrajectoryAction, FollowJointTrajectory
                               GripperCommand, GripperCommandAction, GripperCommandGoal, JointTolerance,
                               JointTrajectoryControllerState)
 from control_msgs.srv import QueryTrajectoryState
-from gazebo_msgs.srv import SpawnModel
+from controller_manager_msgs.srv import SwitchController, SwitchControllerRequest
+from gazebo_msgs.srv import DeleteModel, SpawnModel
 from geometry_msgs.msg import Pose
 from sensor_msgs.msg import JointState
+from std_srvs.srv import Empty
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from sim_support import WALL_TIMEOUT, print_figures, wait_for, wait_for_running_controllers
@@ -144,6 +148,13 @@ class Arm(unittest.TestCase):
         self.trajectory_clients[0].send_goal(goal)
         state, result = self.result()
         self.assertEqual((state, result.error_code), (GoalStatus.REJECTED, FollowJointTrajectoryResult.INVALID_JOINTS))
+        self.assertIn("wrist_4_joint", result.error_string)
+        # One joint named six times: rejected too (upstream's mapping would accept it and move one joint).
+        goal.trajectory.joint_names = [JOINTS[0]] * 6
+        self.trajectory_clients[0].send_goal(goal)
+        state, result = self.result()
+        self.assertEqual((state, result.error_code), (GoalStatus.REJECTED, FollowJointTrajectoryResult.INVALID_JOINTS))
+        self.figures.append(f"a goal naming {JOINTS[0]} six times: REJECTED INVALID_JOINTS, '{result.error_string}'")
 
     def test_05_the_command_topic_moves_the_arm_without_the_action(self):
         target = [-0.3, 0.4, 0.5, 0.2, -0.3, 0.1]
@@ -186,6 +197,48 @@ class Arm(unittest.TestCase):
                             f"stalled at {closed.position:.4f} m, effort {closed.effort:.1f} N; mimic finger "
                             f"{abs(leader - follower) * 1000:.3f} mm from its leader")
 
+    def test_08_goals_past_the_fingers_travel_each_get_a_result(self):
+        """The finger travels 0 to 0.04 m: each goal beyond ends (stalled at the limit) within 3 s of sim time."""
+        self.assertTrue(rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)("box").success)
+        for position in (0.05, -0.01, 1e300, -5.0):
+            start = rospy.get_time()
+            self.gripper.send_goal(GripperCommandGoal(GripperCommand(position, 30.0)))
+            self.assertTrue(self.gripper.wait_for_result(rospy.Duration(WALL_TIMEOUT)), f"no result for {position}")
+            took, result = rospy.get_time() - start, self.gripper.get_result()
+            self.assertLess(took, 3.0, position)
+            self.assertIn(self.gripper.get_state(), (GoalStatus.SUCCEEDED, GoalStatus.ABORTED), position)
+            self.assertTrue(-0.001 < result.position < 0.041, (position, result.position))
+            self.figures.append(f"gripper goal {position:g} m: {GoalStatus.to_string(self.gripper.get_state())} "
+                                f"(stalled {result.stalled}) at {result.position:.4f} m after {took:.2f} s of sim time")
+
+    def test_09_a_switch_pending_when_the_arm_is_deleted_is_answered(self):
+        """Physics paused, a STRICT switch with timeout 0 waits for the next update for ever; deleting the arm
+        answers it (false, nothing switched), and /clock runs on after the unpause."""
+        rospy.ServiceProxy("/gazebo/pause_physics", Empty)()
+        # Persistent: its transport is set once connected, just before the request is written, so the delete
+        # below comes after the switch reached the simulator.
+        switch = rospy.ServiceProxy("/controller_manager/switch_controller", SwitchController, persistent=True)
+        answers = []
+
+        def call():
+            try:
+                answers.append(switch(start_controllers=[], stop_controllers=["gripper_controller"],
+                                      strictness=SwitchControllerRequest.STRICT, start_asap=False, timeout=0.0).ok)
+            except rospy.ServiceException as error:
+                answers.append(error)
+        caller = threading.Thread(target=call, daemon=True)
+        caller.start()
+        wait_for(lambda: switch.transport is not None, what="the switch call connected")
+        self.assertTrue(caller.is_alive(), answers)
+        self.assertTrue(rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)("robot").success)
+        caller.join(WALL_TIMEOUT)
+        self.assertFalse(caller.is_alive(), "the switch call was never answered")
+        self.assertEqual(answers, [False])
+        rospy.ServiceProxy("/gazebo/unpause_physics", Empty)()
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() > start + 0.5, what="/clock running after the delete")
+        self.figures.append("switch_controller pending (paused, STRICT, timeout 0) when the arm was deleted: "
+                            "answered ok=False")
 
 if __name__ == "__main__":
     rostest.rosrun("mbot_tests", "arm", Arm)

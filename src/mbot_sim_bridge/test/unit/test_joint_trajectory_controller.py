@@ -7,6 +7,7 @@ import pytest
 from ros_control_fixtures import (expand_xacro_arm, recording_batches, run_until_ended, simulate, start_controllers,
                                   switch, switch_stepping)
 
+from mbot_sim_bridge.core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
     ABORTED, CANCELED, GOAL_TOLERANCE_VIOLATED, INVALID_GOAL, INVALID_JOINTS, PATH_TOLERANCE_VIOLATED, SUCCEEDED,
@@ -189,8 +190,11 @@ BAD_PARAMETERS = [
     ({"joints": [1, 2]}, True, "The 'joints' parameter contains a non-string element"),
     ({"joints": []}, True, "Could not find 'joints' parameter (namespace: /arm/arm_controller)."),
     ({"joints": ["shoulder", "wrist"]}, True, "Could not find joint 'wrist' in URDF model."),
-    ({"state_publish_rate": 0.0}, False, None),
-    ({"action_monitor_rate": -1.0}, False, None),
+    # Upstream's ros::Duration(1.0 / rate) throws for 1/0 and 1/NaN; a negative period passes its checks every update.
+    ({"state_publish_rate": 0.0}, True, "Exception thrown while initializing controller 'arm_controller'.\nDuration is "
+                                        "out of dual 32-bit range (/arm/arm_controller/state_publish_rate is 0"),
+    ({"action_monitor_rate": math.nan}, True, "Duration is out of dual 32-bit range"),
+    ({"action_monitor_rate": -1.0}, False, "action_monitor_rate is -1: a negative period, so at every update"),
     ({"state_publish_rate": "fast"}, False, "parameter 'state_publish_rate' is 'fast', not a float; using 50.0"),
     ({"constraints": {"goal_time": "soon", "shoulder": {"goal": math.nan}}}, False,
      "parameter 'goal_time' is 'soon', not a float; using 0.0"),
@@ -217,6 +221,20 @@ def test_bad_parameters_refuse_the_controller_or_leave_it_working(bad, refused, 
     controller.command(JointTrajectory(JOINTS, [TrajectoryPoint([0.3, 0.3], time_from_start=0.5)]))
     sim.step(1000)
     assert [joint.position for joint in controller.joints] == pytest.approx([0.3, 0.3], abs=0.02)
+
+
+def test_a_negative_state_publish_rate_publishes_at_every_update_as_upstream():
+    """Upstream's publishState compares last + period < time: a negative period passes at every update."""
+    sim, controller = trajectory_arm("Position", state_publish_rate=-1.0)
+    ros_control = next(plugin for plugin in sim.models["arm"].plugins if isinstance(plugin, GazeboRosControlPlugin))
+    published = []
+
+    def publish(now, update=ros_control.update):
+        published.extend(controller.outbox)
+        update(now)
+    ros_control.update = publish
+    sim.step(100)
+    assert len(published) == round(100 * sim.step_size / ros_control.control_period)
 
 
 def test_a_partial_goal_moves_its_joints_only_when_allowed():

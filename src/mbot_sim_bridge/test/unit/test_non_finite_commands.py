@@ -229,6 +229,34 @@ def test_sdf_inertials_that_would_turn_the_model_nan_are_refused_naming_model_li
         spawned_crate(tmp_path, "crate", (0, 0, 0), **inertial)
 
 
+ARM_ON_BASE = """<robot name="r"><link name="base"><inertial><mass value="{base_mass}"/>
+  <inertia ixx="{base_ixx}" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="1"/>
+  <inertia ixx="{arm_i}" iyy="{arm_i}" izz="{arm_i}" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j" type="{joint}"><parent link="base"/><child link="arm"/><axis xyz="1 0 0"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
+
+
+MASS_RANGE = r"the valid range 0 or >= 1e-06 and <= 1e\+09"
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"base_mass": 1e-300}, r"link 'base': <mass value>: 1e-300 is outside " + MASS_RANGE),
+    ({"base_mass": 1e300}, r"link 'base': <mass value>: 1e\+300 is outside " + MASS_RANGE),
+    ({"base_ixx": 1e300}, r"link 'base': <inertia ixx>: 1e\+300 is outside the valid range >= 0 and <= 1e\+09"),
+    ({"arm_i": 0}, r"link 'arm': <inertia> has principal moments 0, 0, 0 kg m\^2 for a mass of 1 kg; each must be at "
+                   r"least 1e-12"),
+])
+def test_urdf_masses_and_inertias_bullet_cannot_step_are_refused_naming_model_link_and_tag(values, message):
+    """Bullet flung a 1e-7 kg base 50 m and never swung an arm of inertia 0; masses of 0 (none) stay accepted, and a
+    link without inertia is fine once lumped into another by a fixed joint."""
+    urdf = {"base_mass": 1, "base_ixx": 0.01, "arm_i": 0.01, "joint": "revolute", **values}
+    with pytest.raises(ModelError, match=r"^model 'r': " + message + "$"):
+        parse_robot(ARM_ON_BASE.format(**urdf), "model 'r'")
+    parse_robot(ARM_ON_BASE.format(base_mass=0, base_ixx=0, arm_i=0.01, joint="revolute"), "model 'r'")
+    parse_robot(ARM_ON_BASE.format(base_mass=1, base_ixx=0.01, arm_i=0, joint="fixed"), "model 'r'")
+
+
 def test_a_movable_joint_without_an_axis_direction_is_refused():
     urdf = ('<robot name="r"><link name="a"/><link name="b"/><joint name="spin" type="continuous">'
             '<parent link="a"/><child link="b"/>\n<axis xyz="0 0 0"/></joint></robot>')

@@ -54,6 +54,15 @@ DEFAULT_SOLVER_ITERATIONS = 50
 MAX_BODY_LINKS = 128
 
 
+class StepFault(Exception):
+    """Engine.step failed in the work it does for one model (its wheel contacts, the correction of its placement):
+    the simulation contains it to ``model``. What Bullet's own step raises is not one model's and comes as is."""
+
+    def __init__(self, model: str, part: str, error: Exception):
+        super().__init__(f"{part}: {type(error).__name__}: {error}")
+        self.model = model
+
+
 class CachingBulletClient(BulletClient):
     """A BulletClient that binds each PyBullet function to its client once: BulletClient builds a new
     functools.partial on every attribute access, a few per cent of the bridge's loop."""
@@ -375,9 +384,11 @@ class Engine:
             self.set_surfaces(robot, robot.driven_joints)
 
     def step(self, count: int = 1, after_each: Sequence[Callable[[], None]] = ()):
-        """``count`` physics steps; the wheels' friction (wheel_contact) is applied before every one, and each of
+        """``count`` physics steps; the wheels' friction (wheel_contact) and the forces of set joint and link
+        properties are applied before every one, and each of
         ``after_each`` (recorders of per-step state, then the plugins that act on every step) is called after
-        every one, with ``sim_time`` already that step's."""
+        every one, with ``sim_time`` already that step's. ``steps`` counts each step as it is taken, so after a
+        failure it holds the steps done; StepFault names the model whose part of the step raised."""
         step = self.client.stepSimulation  # one attribute lookup: BulletClient builds a partial on each
         before = self._before_step
         while self._settling and count > 0:
@@ -400,7 +411,14 @@ class Engine:
         else:
             for _ in range(count):
                 step()
-            self.steps += count
+                self.steps += 1
+
+    def _apply_wheels(self):
+        for body, wheels in self._wheels.items():
+            try:
+                wheels.apply()
+            except Exception as error:  # one robot's wheel arithmetic; its model is contained by the caller
+                raise StepFault(self._name_of(body), "wheel contacts", error) from error
 
     def add_world(self, world: LoadedWorld):
         """Register the bodies a world loader built, so reset and model queries know them."""
@@ -566,17 +584,20 @@ class Engine:
         for body, counts in list(self._settling.items()):
             counts[0] += 1
             counts[1] += 1
-            for point in client.getContactPoints(bodyA=body):
-                if -point[8] <= deep:
-                    continue
-                counts[1] = 0
-                body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
-                velocity_a = self._point_velocity(body_a, link_a, on_a)
-                velocity_b = self._point_velocity(body_b, link_b, on_b)
-                speed = math.dist(velocity_a, velocity_b)
-                if speed > cap:
-                    for moved in (body_a, body_b):
-                        scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            try:
+                for point in client.getContactPoints(bodyA=body):
+                    if -point[8] <= deep:
+                        continue
+                    counts[1] = 0
+                    body_a, body_b, link_a, link_b, on_a, on_b, normal_on_b = point[1:8]
+                    velocity_a = self._point_velocity(body_a, link_a, on_a)
+                    velocity_b = self._point_velocity(body_b, link_b, on_b)
+                    speed = math.dist(velocity_a, velocity_b)
+                    if speed > cap:
+                        for moved in (body_a, body_b):
+                            scales[moved] = min(scales.get(moved, 1.0), cap / speed)
+            except Exception as error:  # one placed body's arithmetic; its model is contained by the caller
+                raise StepFault(self._name_of(body), "placement correction", error) from error
             if counts[1] >= settled_after:
                 del self._settling[body]
             elif counts[0] == round(SETTLING_WARNING / physics.max_step_size):
@@ -728,7 +749,7 @@ class Engine:
         self._refresh_before_step()
 
     def _refresh_before_step(self):
-        self._before_step = [wheels.apply for wheels in self._wheels.values()]
+        self._before_step = [self._apply_wheels] if self._wheels else []
         if self._joint_damping:
             self._before_step.append(self._damp_joints)
         if self._weightless:

@@ -17,7 +17,7 @@ import pybullet
 
 from .added_plugins import joint_state_blocks, mimic_blocks
 from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
-from .engine import Engine, check_state, frame_velocity
+from .engine import Engine, StepFault, check_state, frame_velocity
 from .errors import ConfigError, ModelError
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
 from . import entity_properties, physics_properties
@@ -174,6 +174,12 @@ class Simulation:
     def delete(self, name: str):
         if name not in self.model_names():
             raise ModelError(f"DeleteModel: model '{name}' does not exist")
+        self._forget(name)
+        self.engine.remove(name)
+        self.version += 1
+
+    def _forget(self, name: str):
+        """Everything but the engine's body of model ``name`` gone: its plugins closed, its streams and wrenches."""
         spawned = self.models.pop(name, None)
         if spawned is not None:
             for plugin in spawned.plugins:
@@ -193,8 +199,6 @@ class Simulation:
         for key in [key for key in self._property_undo if key[0] == name]:
             del self._property_undo[key]
         self._joint_limits = {key: value for key, value in self._joint_limits.items() if key[0] != name}
-        self.engine.remove(name)
-        self.version += 1
 
     # -- wrenches from outside (apply_body_wrench) ---------------------------------------------------------------
     def apply_body_wrench(self, body: str, reference_frame: str, reference_point, force, torque, start_time: float,
@@ -568,13 +572,29 @@ class Simulation:
             self._apply_wrenches()
         if self.joint_efforts.pending():
             self._apply_joint_efforts()
-        recorders = [self._guarded(plugin, plugin.step_recorder, self.sim_time) for plugin in self._recording]
-        per_step = [recorder for recorder in recorders if recorder is not None]
+        per_step = []
+        for plugin in self._recording:
+            recorder = self._guarded(plugin, plugin.step_recorder, self.sim_time)
+            if recorder is not None:
+                per_step.append(self._every_step_call(plugin, recorder))
         per_step += self._every_step_calls
-        self.engine.step(count, per_step)
-        broken = self.engine.models_not_finite()
-        if broken:
-            self._freeze(broken)
+        start = self.engine.steps
+        try:
+            self.engine.step(count, per_step)
+        except StepFault as fault:
+            self._freeze([fault.model], f"its part of the physics step failed ({fault})")
+        except Exception as error:  # Bullet's own step: no one model to blame, so the world is built again
+            failed_at = self.sim_time
+            self._freeze(self.engine.models_not_finite(), "the physics step made its state NaN")
+            self.engine.steps = start + count  # the rest of the batch is skipped, so sim time goes on
+            _logger.error(f"the physics step at {failed_at:.3f} s failed ({type(error).__name__}: {error}); the world "
+                          f"was built again with every model's state, and sim time moved on to {self.sim_time:.3f} s "
+                          "without physics")
+        else:
+            broken = self.engine.models_not_finite()
+            if broken:
+                self._freeze(broken, "the physics step made its state NaN")
+        count = self.engine.steps - start  # fewer than asked when a model's part of the step failed
         now = self.sim_time
         due = [plugin for plugin in self._plugins if self._guarded(plugin, plugin.timer.due, now)]
         if before_updates is not None:
@@ -588,16 +608,16 @@ class Simulation:
             self.viewer.follow()
         return count
 
-    def _freeze(self, names: Sequence[str]):
-        """Models whose state the physics made NaN go back to their spawn state (a robot with its plugins stopped)
-        until a reset; one that turns NaN again by itself is deleted, so the recovery is not repeated every
-        step. Bullet has by then spread the NaN through its broadphase (left alone, every other model sinks
-        through the ground, and even a static ground plane reads NaN), so the world is rebuilt with every other
-        moving model's state carried over."""
+    def _freeze(self, names: Sequence[str], reason: str):
+        """Models whose state the physics made NaN (or whose part of a step raised: ``reason``) go back to their
+        spawn state (a robot with its plugins stopped) until a reset; one that fails again by itself is deleted,
+        so the recovery is not repeated every step. Bullet has by then spread the NaN through its broadphase (left
+        alone, every other model sinks through the ground, and even a static ground plane reads NaN), so the
+        world is rebuilt with every other moving model's state carried over."""
         for name in [name for name in names if name in self._frozen]:
             self.delete(name)
-            _logger.error(f"model '{name}': the physics made its state NaN again after it was put back at its spawn "
-                          "pose, with nothing driving it; it is deleted")
+            _logger.error(f"model '{name}': {reason} again after it was put back at its spawn pose, with nothing "
+                          "driving it; it is deleted")
         names = [name for name in names if name in self.model_names()]
         moving = [name for name in self.engine.model_names() if name not in names and not (
             name in self.world_models and self.world_models[name].static)]
@@ -606,32 +626,37 @@ class Simulation:
         self._rebuild()
         self.engine.steps, self.engine.time_offset = steps, time_offset
         for name, state in kept.items():
-            self.engine.restore_body_state(name, state)
+            if name in self.engine.model_names():  # not one the rebuild had to remove
+                self.engine.restore_body_state(name, state)
         self._frozen.update(names)
         self._schedule()
         self.version += 1
         for name in names:
-            _logger.error(f"model '{name}': the physics step made its state NaN; it is put back at its spawn pose "
-                          "and frozen (a robot's plugins stopped) until reset_world or reset_simulation")
+            _logger.error(f"model '{name}': {reason}; it is put back at its spawn pose and frozen (a robot's plugins "
+                          "stopped) until reset_world or reset_simulation")
 
     def step(self, count: int, before_updates: Optional[BeforeUpdates] = None):
         """Exactly ``count`` physics steps, with every plugin event on the way."""
         while count > 0:
             count -= self.advance(count, before_updates)
 
-    def _every_step_call(self, plugin: Plugin) -> Callable[[], None]:
-        """``plugin.on_step`` as a call for ``Engine.step`` to make after every step of a batch; after a failure
-        (the plugin is then disabled) the rest of the batch skips it."""
+    def _every_step_call(self, plugin: Plugin, recorder: Optional[Callable[[], None]] = None) -> Callable[[], None]:
+        """``plugin.on_step`` (or ``recorder``, what its step_recorder returned) as a call for ``Engine.step`` to
+        make after every step of a batch; after a failure (the plugin is then disabled) the rest of the batch skips
+        it."""
         step_size, model = self.step_size, plugin.context.model
 
-        def on_step():
+        def guarded():
             if plugin in model.plugins:  # a failed plugin is removed from its model's few
                 # _guarded written out: this runs after every physics step, where each extra call costs
                 try:
-                    plugin.on_step(step_size)
+                    if recorder is None:
+                        plugin.on_step(step_size)
+                    else:
+                        recorder()
                 except Exception as error:  # the plugin boundary, as in _guarded
                     self._disable(plugin, error)
-        return on_step
+        return guarded
 
     def _guarded(self, plugin: Plugin, method, *arguments):
         """``method(*arguments)``; a plugin that raises is disabled (None is returned), and the simulation and
@@ -676,17 +701,40 @@ class Simulation:
             self._guarded(plugin, plugin.reset, self.sim_time)
 
     def _rebuild(self):
-        """Every model built again in its original order, as a new run would: see Engine.restart."""
-        self.engine.restart()
-        self._forget_set_properties()  # the models are loaded as described
+        """Every model built again in its original order, as a new run would: see Engine.restart. A model that
+        cannot be built again (a mesh file gone since it was spawned) is removed, with one error, and the rest
+        is built again without it; for a world the unit is what was loaded at once (the .world file's models, or
+        one spawn_sdf_model's)."""
+        while True:
+            self.engine.restart()
+            self._forget_set_properties()  # the models are loaded as described
+            names, error = self._build_again()
+            if not names:
+                return
+            for name in names:
+                self._forget(name)
+            self._schedule()
+            _logger.error(f"model{'s' if len(names) > 1 else ''} {', '.join(repr(name) for name in names)}: could not "
+                          f"be built again ({type(error).__name__}: {error}); removed")
+
+    def _build_again(self) -> Tuple[List[str], Optional[Exception]]:
+        """The models of ``_build_order`` built in the restarted engine; returns the names of the first entry that
+        failed (none built after it) and its error."""
         for entry in self._build_order:
             if isinstance(entry, str):
-                self.engine.respawn(self.models[entry].robot)
+                try:
+                    self.engine.respawn(self.models[entry].robot)
+                except Exception as error:  # the model's own description or files; contained to it
+                    return [entry], error
                 if self.viewer is not None:
                     self.viewer.show_robot(self.models[entry].robot)
             else:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
-                self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
+                try:
+                    self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
+                except Exception as error:  # as above
+                    return [model.name for model in kept], error
+        return [], None
 
     def _forget_set_properties(self):
         self._property_undo.clear()

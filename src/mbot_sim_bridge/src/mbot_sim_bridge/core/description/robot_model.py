@@ -74,6 +74,12 @@ _SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)
 # kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
 _MAX_MASS = 1e9
 _MAX_INERTIA = 1e9
+# A link's mass, when it has one, and the principal moments of a Bullet link with mass: the least of SDF links'
+# (sdf_world) too. Below them Bullet flung or froze what it moved: a 1e-7 kg base under a 1 kg arm flew 50 m, a
+# 1e-300 kg one was dragged 0.2 m, and an arm with inertia 0 never swung (ODE says "inertia must be positive
+# definite" and steps on). 0 keeps its URDF meaning: no mass, as a link without <inertial>.
+_LEAST_MASS = 1e-6
+_LEAST_MOMENT = 1e-12
 # A joint axis shorter than this is taken for none (normalising it would lose all precision).
 _MIN_AXIS_LENGTH = 1e-6
 
@@ -329,7 +335,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
         if inertial is not None and inertial.find("mass") is not None:
             mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
             try:
-                check_range(mass, 0.0, _MAX_MASS)
+                check_range(mass, 0.0, _MAX_MASS, least_positive=_LEAST_MASS)
             except ValueError as error:
                 raise ModelError(f"{source}: link '{link_name}': <mass value>: {error}") from None
         kinds = [geometry[0].tag for geometry in (c.find("geometry") for c in element.findall("collision"))
@@ -719,7 +725,7 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
         if links[name].has_inertial and inertial is not None:
             masses[holder].append((inertial, offset))
     for holder, parts in masses.items():
-        _add_inertial(holders[holder], parts, document)
+        _add_inertial(holders[holder], parts, document, f"{source}: link '{holder}'")
     for joint in joints.values():
         if joint.type == "fixed" or joint.child in dropped:
             continue
@@ -772,10 +778,11 @@ def _add_joint(robot: ElementTree.Element, name: str, kind: str, parent: str, ch
     return joint
 
 
-def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocument] = None):
+def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocument] = None, where: str = ""):
     """The combined inertial of ``parts`` ((<inertial>, pose of its link in ``link``'s frame)) about their common
     centre of mass, as sdformat lumps fixed joints; a negligible one when there is no mass (PyBullet would give
-    1 kg and unit inertia)."""
+    1 kg and unit inertia). With mass, its principal moments must be at least _LEAST_MOMENT (``where`` names the
+    link in the ModelError): checked after lumping, as a massive link without inertia fixed to another is fine."""
     total, centre, tensor = 0.0, np.zeros(3), np.zeros((3, 3))
     placed = []
     for inertial, offset in parts:
@@ -801,6 +808,11 @@ def _add_inertial(link: ElementTree.Element, parts, document: Optional[XmlDocume
     for mass, position, rotated in placed:
         arm = position - centre
         tensor += rotated + mass * (arm @ arm * np.eye(3) - np.outer(arm, arm))
+    moments = np.linalg.eigvalsh(tensor)
+    if moments[0] < _LEAST_MOMENT:
+        lumped = " with the links fixed to it" if len(parts) > 1 else ""
+        raise ModelError(f"{where}{lumped}: <inertia> has principal moments {', '.join(f'{m:g}' for m in moments)} "
+                         f"kg m^2 for a mass of {total:g} kg; each must be at least {_LEAST_MOMENT:g}")
     # Products far below the moments are rounding; PyBullet would turn them into a tiny rotation of the frame.
     tensor[np.abs(tensor) < 1e-12 * max(np.trace(tensor), _NEGLIGIBLE_INERTIA)] = 0.0
     ElementTree.SubElement(element, "origin", xyz=" ".join(repr(float(v)) for v in centre), rpy="0 0 0")

@@ -16,6 +16,10 @@ class ControllerInitError(Exception):
     """A controller's init failed; the message lines are what upstream logs before 'Initializing ... failed'."""
 
 
+class ControllerInitException(Exception):
+    """What upstream's init throws (ros::Duration out of range): controller_manager logs it as a thrown exception."""
+
+
 @dataclass
 class LoadedController:
     name: str
@@ -85,7 +89,7 @@ class ControllerManager:
                 _logger.error("Failed to initialize the controller")
                 _logger.error(f"Initializing controller '{name}' failed")
                 return False
-            except HardwareInterfaceError as error:
+            except (HardwareInterfaceError, ControllerInitException) as error:
                 _logger.error(f"Exception thrown while initializing controller '{name}'.\n{error}")
                 _logger.error(f"Initializing controller '{name}' failed")
                 return False

@@ -23,7 +23,7 @@ from ..log import get_logger, warn_once
 from .angles import shortest_angular_distance
 from .control_toolbox import Pid
 from .controller_interface import Controller, param
-from .controller_manager import ControllerInitError
+from .controller_manager import ControllerInitError, ControllerInitException
 from .hardware_interface import POSITION
 
 _logger = get_logger(__name__)
@@ -216,9 +216,17 @@ def _point_valid(point: TrajectoryPoint, joints: int) -> bool:
     return all(not values or len(values) == joints for values in (point.velocities, point.accelerations))
 
 
-def _period(rate: float) -> float:
-    """A rate's period; 0 (never) for a rate that is not a positive number, as upstream's 1/0 never comes."""
-    return 1.0 / rate if rate > 0.0 and math.isfinite(rate) else 0.0
+def _period(rate: float, name: str, namespace: str) -> float:
+    """Upstream's ros::Duration(1.0 / rate): a rate of 0 (or NaN, or one below 2^-31 Hz) makes that throw and the
+    load fail; a negative rate gives a negative period, which upstream's checks pass at every update (said once
+    here, as upstream says nothing); inf gives 0."""
+    period = 1.0 / rate if rate != 0.0 else math.inf
+    if not abs(period) < 2.0 ** 31:
+        raise ControllerInitException(f"Duration is out of dual 32-bit range ({namespace}/{name} is {rate:g}, a period "
+                                      f"of 1/{rate:g} s)")
+    if period < 0.0:
+        warn_once(_logger, f"{namespace}/{name} is {rate:g}: a negative period, so at every update, as upstream")
+    return period
 
 
 class TrajectoryError(Exception):
@@ -272,8 +280,10 @@ class JointTrajectoryController(Controller):
         super().__init__(name, hw, params, context)
         namespace = context.namespace
         self.namespace = namespace
-        self.state_publish_period = _period(param(params, "state_publish_rate", 50.0, float, namespace))
-        self.action_monitor_period = _period(param(params, "action_monitor_rate", 20.0, float, namespace))
+        self.state_publish_period = _period(param(params, "state_publish_rate", 50.0, float, namespace),
+                                            "state_publish_rate", namespace)
+        self.action_monitor_period = _period(param(params, "action_monitor_rate", 20.0, float, namespace),
+                                             "action_monitor_rate", namespace)
         self.stop_trajectory_duration = param(params, "stop_trajectory_duration", 0.0, float, namespace)
         if not 0.0 <= self.stop_trajectory_duration < math.inf:
             warn_once(_logger, f"{namespace}/stop_trajectory_duration is {self.stop_trajectory_duration}, not a "
@@ -535,10 +545,11 @@ class JointTrajectoryController(Controller):
                 self.ended.append(GoalEnd(self.active_goal, SUCCEEDED))
                 self.active_goal = None
             self.adapter.command(period, self.desired, self.error)
-            if self.state_publish_period > 0.0 and self._last_state_publish + self.state_publish_period < self.uptime:
+            # As upstream's publishState: a period of 0 never publishes, a negative one at every update.
+            if self.state_publish_period != 0.0 and self._last_state_publish + self.state_publish_period < self.uptime:
                 self._last_state_publish += self.state_publish_period
                 self.outbox.append((now, self._points(None)))
-            if (self.active_goal is not None and self.action_monitor_period > 0.0
+            if (self.active_goal is not None
                     and self.time - self._last_feedback >= self.action_monitor_period - 1e-9):
                 self._last_feedback = self.time
                 self.outbox.append((now, self._points(self.active_goal)))
