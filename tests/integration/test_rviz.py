@@ -10,6 +10,7 @@ screenshot.
 """
 import glob
 import os
+import re
 import shutil
 import subprocess
 import time
@@ -40,6 +41,7 @@ STEADY = 3.0
 # Each screenshot is an xwd, a PNG and its analysis: taken back to back they were a tenth of a test's CPU.
 SCREENSHOT_PERIOD = 0.5
 RVIZ_ATTEMPTS = 2
+TEST_FRAME_RATE = 5  # frames per second; the shipped configs ask for 30 (see at_test_frame_rate)
 # Config -> (launch file and args, the robot_description it draws, topics to wait for); others: the play ground.
 SCENES = {"multi_mbot.rviz": (("multi_mbot.launch", "count:=2"), "/mbot_1/robot_description",
                               {"/mbot_1/odom", "/mbot_2/scan", "/tf", "/tf_static"})}
@@ -143,9 +145,23 @@ def published(master):
     return {topic for topic, nodes in publishers if nodes}
 
 
+def at_test_frame_rate(config, folder):
+    """A copy of ``config`` in ``folder`` that differs only in its Frame Rate: software OpenGL drawing the 3D view
+    30 times a second was most of these tests' CPU, and what is drawn does not depend on how often."""
+    with open(config) as stream:
+        text = stream.read()
+    copy, count = re.subn(r"(?m)^(\s+Frame Rate:) \d+$", rf"\g<1> {TEST_FRAME_RATE}", text)
+    assert count == 1, f"{config}: no single 'Frame Rate:' line to lower"
+    path = os.path.join(folder, os.path.basename(config))
+    with open(path, "w") as stream:
+        stream.write(copy)
+    return path
+
+
 def start_rviz(config, environment, log_path, master, timeout):
-    """rviz on ``config``, its output in ``log_path``, once it has registered with the master (or exited); the
-    caller stops it."""
+    """rviz on ``config`` (at the tests' frame rate), its output in ``log_path``, once it has registered with the
+    master (or exited); the caller stops it."""
+    config = at_test_frame_rate(config, os.path.dirname(log_path))
     with open(log_path, "w") as log:
         rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)

@@ -14,7 +14,7 @@ from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
 from test_rviz import (DRAW_TIMEOUT, MIN_ROBOT_PIXELS, assert_no_tf_errors, base_link_colour, colour_mask,
-                       node_registered, parse_colour, published, view_3d, watch)
+                       parse_colour, published, start_rviz, view_3d, watch)
 from xvfb import Xvfb
 
 pytestmark = pytest.mark.long
@@ -48,14 +48,9 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
     with Xvfb(tmp_path / "xvfb.log") as server:
         environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
         log_path = tmp_path / "rviz.log"
-        with open(log_path, "w") as log:
-            rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", CONFIG, "__name:=rviz"], env=environment,
-                                    stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                    start_new_session=True)
+        rviz = start_rviz(CONFIG, environment, log_path, master, 30)
         driver = None
         try:
-            wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), 30,
-                       "rviz to register with the master")
             image = watch(server, shots[0], lambda image: robot_centre(image, background, colour) is not None,
                           DRAW_TIMEOUT, STEADY)
             start = robot_centre(image, background, colour)

@@ -88,6 +88,7 @@ def wheels_fail(sim):
     """A stand-in for the mbot's wheel contacts whose arithmetic raises (Engine.step applies them every step)."""
     wheels, _ = failing_once(lambda: None, DIVISION_BY_ZERO)
     sim.engine._wheels[sim.models["mbot"].robot.body] = SimpleNamespace(apply=wheels)
+    sim.engine._refresh_before_step()  # as Engine.set_surfaces does once it has the wheels
 
 
 def placement_correction_fails(sim):

@@ -657,21 +657,19 @@ class Engine:
         body = self.body_of(name)
         self.client.resetBasePositionAndOrientation(body, *state.pose)
         self.client.resetBaseVelocity(body, *state.velocity)
-        # Fixed joints have no state, and PyBullet refuses an empty one.
-        moving = [(index, joint) for index, joint in enumerate(state.joints) if joint[0]]
-        if moving:
-            indices, joints = zip(*moving)
-            positions, velocities = zip(*joints)
-            self.client.resetJointStatesMultiDof(body, indices, positions, velocities)
+        # Fixed joints have no state, and PyBullet refuses an empty one. One joint per call: PyBullet 3.2.7's
+        # resetJointStatesMultiDof (all joints at once) crashed the process on a robot's saved states.
+        for index, (positions, velocities) in enumerate(state.joints):
+            if positions:
+                self.client.resetJointStateMultiDof(body, index, list(positions), list(velocities))
 
     def _restore_initial_state(self, body: int):
         initial = self._initial[body]
         self.client.resetBasePositionAndOrientation(body, initial.position, initial.orientation)
         self.client.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0))
-        if initial.joint_positions:
-            positions = list(initial.joint_positions.values())
-            self.client.resetJointStatesMultiDof(body, list(initial.joint_positions), positions,
-                                                 [[0.0] * (3 if len(q) == 4 else len(q)) for q in positions])
+        for index, position in initial.joint_positions.items():  # one per call, as in restore_body_state
+            self.client.resetJointStateMultiDof(body, index, list(position), [0.0] * (3 if len(position) == 4 else
+                                                                                       len(position)))
 
     def close(self):
         if self.client is not None:
