@@ -47,6 +47,10 @@ PENETRATION_TOLERANCE = 1.0e-5  # m
 # A friction coefficient far beyond any real one (rubber on asphalt is about 1); the wheel contact model's forces
 # stay finite below it.
 MAX_WHEEL_MU = 1.0e3
+# Gazebo's default contact stiffness (SDF <kp>): a spring this stiff is a rigid contact.
+RIGID_CONTACT_STIFFNESS = 1.0e12  # N/m
+# A finger without mass (a massless link) is damped as one of a gram.
+_MIN_SQUEEZING_MASS = 1.0e-3  # kg
 # PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
 # every query fails ("GetBasePositionAndOrientation failed").
 MAX_BODY_LINKS = 128
@@ -676,6 +680,25 @@ class Engine:
         # A wheel's friction is the wheel contact model's (wheel_contact), not Bullet's.
         self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or modelled else min(mu1, mu2),
                                    spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
+        stiffness = self._squeezing_contact(robot, link_name)
+        if stiffness is not None:
+            self.client.changeDynamics(robot.body, index, contactStiffness=stiffness[0], contactDamping=stiffness[1])
+
+    def _squeezing_contact(self, robot: SpawnedRobot, link_name: str) -> Optional[Tuple[float, float]]:
+        """(contact stiffness N/m, damping N·s/m) for a link on a prismatic joint (a gripper finger), else None.
+
+        ODE lets a contact rest within the world's contact_surface_layer uncorrected, so a finger pressed on a
+        box stands still in Gazebo. Bullet's rigid contacts push it out by the whole depth every step and it
+        reads effort·step/mass of velocity while it does not move (0.06 m/s at 30 N), so a gripper action never
+        stalls. As a spring (ODE's kp/kd, which Bullet combines per pair as ODE does) that holds the joint's
+        effort limit within the surface layer, critically damped for the link's mass, it rests (0 m/s)."""
+        joint = next((joint for joint in robot.model.joints.values() if joint.child == link_name), None)
+        layer = self.physics.contact_surface_layer
+        if joint is None or joint.type != "prismatic" or joint.effort <= 0.0 or layer <= 0.0:
+            return None
+        stiffness = min(joint.effort / layer, RIGID_CONTACT_STIFFNESS)
+        mass = max(robot.model.links[link_name].mass, _MIN_SQUEEZING_MASS)
+        return stiffness, 2.0 * math.sqrt(stiffness * mass)
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)
