@@ -10,7 +10,6 @@ import numpy as np
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, run_until_ended, simulate, start_controllers
 
 from mbot_gazebo.pick_plan import ArmGeometry, pick_and_place
-from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.geometry import compose, inverse
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
@@ -25,6 +24,8 @@ TABLE_HEIGHT = 0.05
 REACH, SIDEWAYS = 0.38, 0.3  # m: the box's distance from the arm's axis; how far it is carried along y
 GRIPPER = "gripper_base_link"
 WORLD = """<sdf version='1.6'><world name='pick'>
+  <include><uri>model://ground_plane</uri></include>
+  {plugins}
   <model name='table'><static>true</static><pose>{x} 0 {table_z} 0 0 0</pose><link name='link'>
     <collision name='collision'><geometry><box><size>0.2 0.8 {table_height}</size></box></geometry></collision>
   </link></model>
@@ -48,23 +49,25 @@ class PickRecord:
         return max(self.slips)
 
 
-def pick_world(tmp_path, x, y):
+def pick_world(tmp_path, x, y, plugins=""):
+    """The table and the box at (x, y) on it, with the world's ``plugins`` (SDF <plugin> elements)."""
     path = os.path.join(str(tmp_path), "pick.world")
     side = BOX_SIDE
     with open(path, "w") as world:
         world.write(WORLD.format(x=x, y=y, z=TABLE_HEIGHT + side / 2, yaw=math.atan2(y, x), table_z=TABLE_HEIGHT / 2,
-                                 table_height=TABLE_HEIGHT, mass=BOX_MASS, inertia=BOX_MASS * side * side / 6, side=side))
-    return parse_world(path)
+                                 table_height=TABLE_HEIGHT, mass=BOX_MASS, inertia=BOX_MASS * side * side / 6, side=side,
+                                 plugins=plugins))
+    return path
 
 
-def arm_with_box(tmp_path, urdf_extra=""):
+def arm_with_box(tmp_path, urdf_extra="", world_plugins=""):
     """The arm (``urdf_extra`` added inside its <robot>) with its controllers started, the table and box."""
     urdf = expand_xacro(ARM_XACRO).replace("</robot>", urdf_extra + "</robot>")
-    sim, spawned, plugin = simulate(urdf, load_yaml(CONFIG), "robot", package_uris=resolve_package_uris,
-                                    namespace="/")
-    arm = start_controllers(sim, plugin, "arm_controller", "joint_state_controller", "gripper_controller")
     pan = math.asin(SIDEWAYS / 2 / REACH)
-    sim.add_world(pick_world(tmp_path, REACH * math.cos(pan), -SIDEWAYS / 2))
+    world = pick_world(tmp_path, REACH * math.cos(pan), -SIDEWAYS / 2, world_plugins)
+    sim, spawned, plugin = simulate(urdf, load_yaml(CONFIG), "robot", package_uris=resolve_package_uris,
+                                    namespace="/", world=world)
+    arm = start_controllers(sim, plugin, "arm_controller", "joint_state_controller", "gripper_controller")
     return sim, spawned, arm, plugin.manager.find("gripper_controller").controller
 
 

@@ -42,9 +42,10 @@ BUILTIN_MODEL_NAMES = tuple(_BUILTIN_MODELS)
 # correcting velocity would throw bodies and a surface layer sink them (in Gazebo, and in a saved world).
 _CONSTRAINT_LIMITS = {"erp": 1.0, "contact_max_correcting_vel": 1.0e4, "contact_surface_layer": 0.1}
 # Children read elsewhere or without effect on contacts pass silently; unsupported and unknown ones warn once.
+# A world's <plugin>s are built by the Simulation (WorldDescription.plugins), which says which it lacks.
 _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "gui", "physics", "scene", "light",
-                  "spherical_coordinates", "state", "frame", "road"}
-_WORLD_UNSUPPORTED = {"actor", "population", "plugin"}
+                  "spherical_coordinates", "state", "frame", "road", "plugin"}
+_WORLD_UNSUPPORTED = {"actor", "population"}
 _MODEL_IGNORED = {"static", "pose", "self_collide", "allow_auto_disable", "enable_wind", "frame"}
 _MODEL_UNSUPPORTED = {"joint", "plugin", "gripper"}
 _LINK_IGNORED = {"pose", "inertial", "visual", "sensor", "self_collide", "enable_wind", "must_be_base_link",
