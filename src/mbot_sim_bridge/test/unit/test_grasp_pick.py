@@ -1,6 +1,6 @@
 """Pick and place with the workspace's arm (arm_pick.py): the 0.2 kg box is lifted 0.2 m, carried 0.3 m and set
 down on its target with less than 5 mm of slip in the fingers, held by friction alone, then with
-libgazebo_ros_link_attacher.so attaching it while the fingers hold it."""
+libgazebo_ros_link_attacher.so (in the pick world) attaching it while the fingers hold it."""
 import pytest
 from arm_pick import arm_with_box, pick, placement_error
 
@@ -8,13 +8,12 @@ from mbot_sim_bridge.core.manipulation.link_attacher import LinkAttacher
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import ABORTED
 
 MAX_SLIP = 0.005  # m
-ATTACHER = "<plugin name='ros_link_attacher_plugin' filename='libgazebo_ros_link_attacher.so'/>"
 # The gripper's Gazebo link: gripper_base_link hangs on tool0 and wrist_3_link by fixed joints, lumped into it.
 GRIPPER_LINK = ("robot", "wrist_3_link", "box", "link")
 
 
-def test_a_friction_grasp_lifts_carries_and_sets_down_the_box_without_slipping(tmp_path):
-    sim, spawned, arm, gripper = arm_with_box(tmp_path)
+def test_a_friction_grasp_lifts_carries_and_sets_down_the_box_without_slipping():
+    sim, spawned, arm, gripper = arm_with_box()
     try:
         record = pick(sim, spawned, arm, gripper)
         closing = record.outcomes["close"]
@@ -28,8 +27,8 @@ def test_a_friction_grasp_lifts_carries_and_sets_down_the_box_without_slipping(t
         sim.close()
 
 
-def test_the_link_attacher_holds_the_box_from_closing_to_opening(tmp_path):
-    sim, spawned, arm, gripper = arm_with_box(tmp_path, world_plugins=ATTACHER)
+def test_the_link_attacher_holds_the_box_from_closing_to_opening():
+    sim, spawned, arm, gripper = arm_with_box()
     try:
         attacher, = sim.world_plugins.plugins
         assert isinstance(attacher, LinkAttacher)
