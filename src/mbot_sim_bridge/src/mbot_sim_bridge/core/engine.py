@@ -294,6 +294,8 @@ class Engine:
         self.physics = physics
         self._configure()
         self.steps = 0
+        # How many times the world was built again (restart): PyBullet then numbers bodies and constraints anew.
+        self.rebuilds = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
@@ -331,6 +333,7 @@ class Engine:
         self.client.resetSimulation()
         self._configure()
         self.steps = 0
+        self.rebuilds += 1
         self.robots.clear()
         self.world_bodies.clear()
         self.dynamic_world_bodies.clear()

@@ -191,11 +191,7 @@ class Plugin:
 
 class WorldPlugin(Plugin):
     """A Gazebo world plugin (``<plugin>`` inside ``<world>``, GZ_REGISTER_WORLD_PLUGIN): built once with the
-    world, told of deletions and rebuilds of the models it may hold on to."""
+    world, told of the deletions of models it may hold on to."""
 
     def model_deleted(self, name: str):
         """Model ``name`` is about to be deleted."""
-
-    def world_rebuilt(self):
-        """Every model was built again (reset_simulation, or a model's state turned NaN): nothing made in the
-        physics before is there any more."""

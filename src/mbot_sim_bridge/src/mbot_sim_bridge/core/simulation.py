@@ -484,8 +484,6 @@ class Simulation:
             else:
                 kept = tuple(model for model in entry.models if model.name in self.world_models)
                 self.engine.add_world(load_world(self.engine.client, replace(entry, models=kept)))
-        for plugin in list(self.world_plugins.plugins):
-            self._guarded(plugin, plugin.world_rebuilt)
 
     def __enter__(self) -> "Simulation":
         return self

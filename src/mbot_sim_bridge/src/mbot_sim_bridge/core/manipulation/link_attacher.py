@@ -46,9 +46,6 @@ class LinkAttacher(WorldPlugin):
     def model_deleted(self, name: str):
         self.joints.release_model(name)
 
-    def world_rebuilt(self):
-        self.joints.forget()
-
     def reset(self, now: float):
         self.joints.release_all()
 
