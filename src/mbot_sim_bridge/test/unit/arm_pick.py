@@ -49,13 +49,14 @@ def box_in_gripper(sim, spawned):
 
 
 def pick(sim, spawned, arm, gripper, after_close: Callable[[], None] = lambda: None,
-         before_release: Callable[[], None] = lambda: None) -> PickRecord:
-    """Runs the pick plan; ``after_close`` and ``before_release`` are called around the carry (an attach and a
-    detach)."""
+         before_release: Callable[[], None] = lambda: None, after_release: Callable[[], None] = lambda: None,
+         max_effort: float = 20.0) -> PickRecord:
+    """Runs the pick plan, the fingers closing with ``max_effort`` (N); ``after_close``, ``before_release`` and
+    ``after_release`` are called around the carry (an attach and a detach, or waits for them)."""
     box = sim.engine.model_pose("box").position
     record = PickRecord(target=(box[0], -box[1], box[2]))  # the other end of the table
     held = None
-    for step in pick_and_place(ArmGeometry.from_description(), box, record.target):
+    for step in pick_and_place(ArmGeometry.from_description(), box, record.target, max_effort=max_effort):
         if step.name == "release":
             before_release()
             held = None
@@ -77,8 +78,19 @@ def pick(sim, spawned, arm, gripper, after_close: Callable[[], None] = lambda: N
         if step.name == "close":
             after_close()
             held = box_in_gripper(sim, spawned).position
+        if step.name == "release":
+            after_release()
     return record
 
 
 def placement_error(sim, record) -> float:
     return float(np.linalg.norm(np.subtract(sim.engine.model_pose("box").position, record.target)))
+
+
+def step_until(sim, condition, seconds: float, what: str):
+    """Step 10 ms at a time until ``condition()``, at most ``seconds`` of sim time."""
+    for _ in range(int(seconds / 0.01)):
+        if condition():
+            return
+        sim.step(10)
+    raise AssertionError(f"{what} not within {seconds} s")

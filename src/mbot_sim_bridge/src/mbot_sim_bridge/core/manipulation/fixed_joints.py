@@ -22,7 +22,7 @@ class _Joint:
     models: Tuple[str, str]
     bodies: Tuple[int, int]
     rebuild: int  # the engine's rebuild count when it was made: after a rebuild it is gone
-    silenced: Optional[BulletLink]  # the second link, colliding with nothing while attached
+    silenced: Tuple[BulletLink, ...]  # the second link's Bullet links, colliding with nothing while attached
 
 
 class FixedJoints:
@@ -80,11 +80,19 @@ class FixedJoints:
                                              (0.0, 0.0, 0.0), child_in_parent.position, (0.0, 0.0, 0.0),
                                              child_in_parent.orientation)
         client.changeConstraint(constraint, maxForce=MAX_HOLDING_FORCE)
-        if silence_second:
-            client.setCollisionFilterGroupMask(second[0], second[1], 0, 0)
-        self._joints[key] = _Joint(constraint, (model_1, model_2), (first[0], second[0]), engine.rebuilds,
-                                   second if silence_second else None)
+        silenced = self._collision_links(model_2, second) if silence_second else ()
+        for body, index in silenced:
+            client.setCollisionFilterGroupMask(body, index, 0, 0)
+        self._joints[key] = _Joint(constraint, (model_1, model_2), (first[0], second[0]), engine.rebuilds, silenced)
         return ""
+
+    def _collision_links(self, model: str, link: BulletLink) -> Tuple[BulletLink, ...]:
+        """The Bullet links holding a link's collisions: a robot's own; all of a world model's body (its
+        collisions are links of their own on it)."""
+        if model in self.simulation.models:
+            return (link,)
+        body = link[0]
+        return tuple((body, index) for index in range(-1, self.simulation.engine.client.getNumJoints(body)))
 
     def _present(self, joint: _Joint) -> bool:
         """Whether the joint's models are still those it joined (not rebuilt, deleted or replaced)."""
@@ -101,8 +109,8 @@ class FixedJoints:
         if self._present(joint):
             client = self.simulation.engine.client
             client.removeConstraint(joint.constraint)
-            if joint.silenced is not None:
-                client.setCollisionFilterGroupMask(*joint.silenced, _DYNAMIC_GROUP, _ALL_MASK)
+            for body, index in joint.silenced:
+                client.setCollisionFilterGroupMask(body, index, _DYNAMIC_GROUP, _ALL_MASK)
         return True
 
     def release_model(self, name: str):
