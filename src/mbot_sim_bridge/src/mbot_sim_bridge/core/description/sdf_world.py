@@ -4,7 +4,8 @@
 ``<include>``, links, collisions, friction, poses composed world_T_model · model_T_link · link_T_collision.
 The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns it into PyBullet
 bodies. Visuals, lights, scene and GUI are left out; physics-relevant elements that are not simulated
-(joints, plugins, unknown geometry) warn once each, naming file and line.
+(joints, models' plugins, unknown geometry) warn once each, naming file and line. The world's own plugins are
+kept for the Simulation, which builds them.
 """
 import os
 import xml.etree.ElementTree as ET
