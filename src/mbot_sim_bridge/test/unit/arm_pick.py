@@ -64,7 +64,8 @@ def pick(sim, spawned, arm, gripper, after_close: Callable[[], None] = lambda: N
             assert gripper.accept_goal(GripperGoal(step.gripper, step.max_effort))
             record.outcomes[step.name] = run_until_ended(sim, gripper)
         else:
-            points = [TrajectoryPoint(list(positions), time_from_start=seconds) for seconds, positions in step.waypoints]
+            points = [TrajectoryPoint(list(positions), time_from_start=seconds)
+                      for seconds, positions in step.waypoints]
             assert arm.accept_goal(TrajectoryGoal(JointTrajectory(arm.joint_names, points)))[0]
             while True:
                 sim.step(10)

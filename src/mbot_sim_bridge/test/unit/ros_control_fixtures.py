@@ -28,9 +28,9 @@ def load_yaml(path):
 
 def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None,
              world=os.path.join(WORLDS, "empty.world")):
-    """A Simulation of ``world`` with the robot spawned from ``urdf``, which is also its robot_description parameter; its
-    gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default the
-    model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
+    """A Simulation of ``world`` with the robot spawned from ``urdf``, which is also its robot_description parameter;
+    its gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default
+    the model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
     tree = {"robot_description": urdf}
     for path, value in [((namespace or name) + "/" + key, config) for key, config in controllers.items()] + list(
             (parameters or {}).items()):

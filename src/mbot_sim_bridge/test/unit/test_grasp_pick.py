@@ -3,7 +3,6 @@ down on its target with less than 5 mm of slip in the fingers, held by friction 
 libgazebo_ros_link_attacher.so (in the pick world) attaching it while the fingers hold it, then with
 libgazebo_grasp_fix.so in the arm's description attaching it when the fingers grip and releasing it when they
 open."""
-import pytest
 from arm_pick import arm_with_box, pick, placement_error, step_until
 
 from mbot_sim_bridge.core.manipulation.grasp_fix import GraspFix
@@ -24,6 +23,13 @@ GRASP_FIX = """<gazebo><plugin name="gazebo_grasp_fix" filename="libgazebo_grasp
 </plugin></gazebo>"""
 
 
+def assert_held_and_placed(sim, record, grasp: str):
+    error = placement_error(sim, record)
+    print(f"figure: {grasp}: slip {record.slip * 1000:.2f} mm, placed {error * 1000:.1f} mm from the target")
+    assert record.slip < MAX_SLIP
+    assert error < 0.01
+
+
 def test_a_friction_grasp_lifts_carries_and_sets_down_the_box_without_slipping():
     sim, spawned, arm, gripper = arm_with_box()
     try:
@@ -31,10 +37,7 @@ def test_a_friction_grasp_lifts_carries_and_sets_down_the_box_without_slipping()
         closing = record.outcomes["close"]
         # The fingers stop on the 4 cm box (2 cm from the centre line each) and the goal ends stalled.
         assert (closing.status, closing.stalled) == (ABORTED, True) and abs(closing.position - 0.02) < 0.002
-        print(f"figure: friction grasp: slip {record.slip * 1000:.2f} mm, placed "
-              f"{placement_error(sim, record) * 1000:.1f} mm from the target")
-        assert record.slip < MAX_SLIP
-        assert placement_error(sim, record) < 0.01
+        assert_held_and_placed(sim, record, "friction grasp")
     finally:
         sim.close()
 
@@ -48,10 +51,7 @@ def test_the_link_attacher_holds_the_box_from_closing_to_opening():
         record = pick(sim, spawned, arm, gripper, after_close=lambda: answers.append(attacher.attach(GRIPPER_LINK)),
                       before_release=lambda: answers.append(attacher.detach(GRIPPER_LINK)))
         assert answers == [(True, "Attach finished."), (True, "")]
-        print(f"figure: link attacher grasp: slip {record.slip * 1000:.2f} mm, placed "
-              f"{placement_error(sim, record) * 1000:.1f} mm from the target")
-        assert record.slip < MAX_SLIP
-        assert placement_error(sim, record) < 0.01
+        assert_held_and_placed(sim, record, "link attacher grasp")
         assert not attacher.joints.holds(GRIPPER_LINK)
     finally:
         sim.close()
@@ -64,12 +64,9 @@ def test_the_grasp_fix_attaches_the_gripped_box_and_releases_it_when_the_fingers
         holders = []
         record = pick(sim, spawned, arm, gripper,
                       after_close=lambda: step_until(sim, lambda: fix.attached, 1.0, "the grasp fix's attachment"),
-                      before_release=lambda: holders.append({box: arm for box, (arm, _) in fix.attached.items()}),
+                      before_release=lambda: holders.append({box: holder for box, (holder, _) in fix.attached.items()}),
                       after_release=lambda: step_until(sim, lambda: not fix.attached, 1.0, "its release"))
         assert holders == [{("box", "link"): "arm"}]  # held all the way
-        print(f"figure: grasp fix grasp: slip {record.slip * 1000:.2f} mm, placed "
-              f"{placement_error(sim, record) * 1000:.1f} mm from the target")
-        assert record.slip < MAX_SLIP
-        assert placement_error(sim, record) < 0.01
+        assert_held_and_placed(sim, record, "grasp fix grasp")
     finally:
         sim.close()

@@ -1,8 +1,8 @@
 """NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
-tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d, mimic
-joints, grasp fix): each value is refused with one line naming the tag, or runs without an exception, and a robot two metres
-away does not move by 1 mm. Every edit is checked to have changed the robot: a tag the robot lacks is added to the
-plugins that read it."""
+tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d,
+mimic joints, grasp fix): each value is refused with one line naming the tag, or runs without an exception, and a
+robot two metres away does not move by 1 mm. Every edit is checked to have changed the robot: a tag the robot lacks
+is added to the plugins that read it."""
 import math
 import os
 import re
