@@ -4,7 +4,8 @@
 trajectory controller still holds them (its desired state within 1e-4 of them). /gazebo/set_model_configuration
 answers bad requests with upstream's message or one naming the value, and nothing moves; spawn_model -J names a
 joint the model lacks in one line and sets the others. get_model_properties and get_link_state answer through ROS
-with upstream's messages."""
+with upstream's messages. The pick world's link attacher attaches and detaches through its services; names of no
+model or link answer false and move nothing."""
 import math
 import subprocess
 import tempfile
@@ -13,7 +14,8 @@ import unittest
 import rospy
 import rostest
 from control_msgs.msg import JointTrajectoryControllerState
-from gazebo_msgs.srv import GetLinkState, GetModelProperties, SetModelConfiguration
+from gazebo_msgs.srv import GetLinkState, GetModelProperties, GetModelState, SetModelConfiguration
+from gazebo_ros_link_attacher.srv import Attach
 from sensor_msgs.msg import JointState
 
 from sim_support import print_figures, wait_for, wait_for_running_controllers
@@ -112,6 +114,23 @@ class ArmInitialJoints(unittest.TestCase):
         self.assertEqual(link_state("robot::wrist_3_link", "nowhere").status_message,
                          "GetLinkState: reference reference_frame not found, did you forget to scope the link by "
                          "model name?")
+
+    def test_the_link_attacher_services(self):
+        rospy.wait_for_service("/link_attacher_node/detach", timeout=30.0)
+        attach = rospy.ServiceProxy("/link_attacher_node/attach", Attach)
+        detach = rospy.ServiceProxy("/link_attacher_node/detach", Attach)
+        model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        before = model_state("box", "world").pose.position
+        bad = [("no_such_model", "link", "table", "link"), ("box", "no_such_link", "table", "link"),
+               ("box", "link", "box", "link"), ("nan", "inf", "1e308", ""), ("box" * 10000, "link", "table", "link")]
+        self.assertEqual([attach(*names).ok for names in bad], [False] * len(bad))
+        self.assertEqual([detach(*names).ok for names in bad], [False] * len(bad))
+        pair = ("box", "link", "table", "link")
+        self.assertEqual([attach(*pair).ok, attach(*pair).ok, detach(*pair).ok, detach(*pair).ok],
+                         [True, True, True, False])
+        after = model_state("box", "world").pose.position
+        moved = math.dist((before.x, before.y, before.z), (after.x, after.y, after.z))
+        self.assertLess(moved, 1e-4)
 
     @staticmethod
     def arm_state():

@@ -6,6 +6,7 @@ import subprocess
 import sys
 import threading
 import time
+from typing import Callable, List
 
 import actionlib
 import numpy as np
@@ -62,18 +63,25 @@ def draw(times, desired, actual, names, out_path, title):
 
 
 def run(out_path: str, gui: bool) -> int:
-    log_dir = os.path.join(os.path.dirname(os.path.abspath(out_path)), "arm_demo_logs")
+    return with_arm_bringup(out_path, gui, "arm", [], "effort trajectory controller", follow_and_draw)
+
+
+def with_arm_bringup(out_path: str, gui: bool, demo: str, launch_args: List[str], what: str,
+                     body: Callable[[str], int]) -> int:
+    """arm_bringup.launch (with ``launch_args``) on a private master, ``body(out_path)`` run against it, the
+    launch stopped after; the launch's log beside the picture."""
+    log_dir = os.path.join(os.path.dirname(os.path.abspath(out_path)), f"{demo}_demo_logs")
     os.makedirs(log_dir, exist_ok=True)
     with PrivateMaster() as master:
         os.environ.update(ROS_MASTER_URI=master.uri, ROS_LOG_DIR=log_dir)
         with open(os.path.join(log_dir, "roslaunch.log"), "w") as launch_log:
             simulation = subprocess.Popen(
-                ["roslaunch", "arm_gazebo", "arm_bringup.launch", f"gui:={str(gui).lower()}"], env=os.environ,
-                stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
+                ["roslaunch", "arm_gazebo", "arm_bringup.launch", f"gui:={str(gui).lower()}"] + launch_args,
+                env=os.environ, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            print(f"mbot demo --arm: arm_bringup.launch, effort trajectory controller (log: "
-                  f"{os.path.relpath(log_dir)})", file=sys.stderr, flush=True)
-            return follow_and_draw(out_path)
+            print(f"mbot demo --{demo}: arm_bringup.launch, {what} (log: {os.path.relpath(log_dir)})",
+                  file=sys.stderr, flush=True)
+            return body(out_path)
         finally:
             stop_process_group(simulation)
 

@@ -28,7 +28,7 @@ from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
-from . import arm_demo
+from . import arm_demo, pick_demo
 from .demo_plot import draw_demo
 
 WORLDS = {"play_ground": "playground.world", "playground": "playground.world", "room": "room.world",
@@ -198,11 +198,16 @@ def main(argv=None):
     parser.add_argument("--gui", action="store_true", help="show the simulator window (needs a DISPLAY)")
     parser.add_argument("--arm", action="store_true",
                         help="instead of the tour: the arm follows a trajectory, drawn to out/arm.png")
-    parser.add_argument("--out", help="picture to write (default out/demo.png, with --arm out/arm.png)")
+    parser.add_argument("--pick", action="store_true",
+                        help="instead of the tour: the arm picks a box and places it, drawn to out/pick.png")
+    parser.add_argument("--out", help="picture to write (default out/demo.png, out/arm.png or out/pick.png)")
     args = parser.parse_args(argv)
-    args.out = args.out or os.path.join(os.getcwd(), "out", "arm.png" if args.arm else "demo.png")
+    picture = "arm.png" if args.arm else "pick.png" if args.pick else "demo.png"
+    args.out = args.out or os.path.join(os.getcwd(), "out", picture)
     if args.arm:
         return arm_demo.run(args.out, args.gui)
+    if args.pick:
+        return pick_demo.run(args.out, args.gui)
 
     world_path = os.path.join(rospkg.RosPack().get_path("mbot_gazebo"), "worlds", WORLDS[args.world])
     model = os.path.join(rospkg.RosPack().get_path("mbot_description"), "urdf", "gazebo",

@@ -78,6 +78,7 @@ class SimBridgeNode:
         self.sim = Simulation(world, REGISTRY, seed, pybullet.GUI if gui else pybullet.DIRECT, joint_state_rate,
                               RosParameters(), resolve_package_uris)
         self.sim.paused = paused or lockstep
+        self.sim.call_in_loop = self.call_in_loop
         physics = world.physics
         self._real_time_factor_param = float(real_time_factor) if real_time_factor else None
         self.physics_changed()

@@ -26,10 +26,11 @@ def load_yaml(path):
         return yaml.safe_load(stream)
 
 
-def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None):
-    """A Simulation with the robot spawned from ``urdf``, which is also its robot_description parameter; its
-    gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default the
-    model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
+def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str, namespace=None,
+             world=os.path.join(WORLDS, "empty.world")):
+    """A Simulation of ``world`` with the robot spawned from ``urdf``, which is also its robot_description parameter;
+    its gazebo_ros_control finds ``controllers`` (a controller YAML) in its namespace (``namespace``, by default
+    the model name) and the other ``parameters`` ({absolute name: value}) where they are named."""
     tree = {"robot_description": urdf}
     for path, value in [((namespace or name) + "/" + key, config) for key, config in controllers.items()] + list(
             (parameters or {}).items()):
@@ -38,7 +39,7 @@ def simulate(urdf, controllers, name="robot", parameters=None, package_uris=str,
         for parent in parents:
             node = node.setdefault(parent, {})
         node[leaf] = value
-    sim = Simulation(parse_world(os.path.join(WORLDS, "empty.world")), CORE_PLUGINS,
+    sim = Simulation(parse_world(world), CORE_PLUGINS,
                      parameters=Parameters(tree), package_uris=package_uris)
     spawned = sim.spawn_robot(parse_robot(package_uris(urdf), f"model '{name}'"), name)
     plugin = next(plugin for plugin in spawned.plugins if isinstance(plugin, GazeboRosControlPlugin))

@@ -1,8 +1,8 @@
 """NaN, inf and huge values on every input of the drives and sensors of published robots (planar move, skid steer,
-tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d, mimic
-joints): each value is refused with one line naming the tag, or runs without an exception, and a robot two metres
-away does not move by 1 mm. Every edit is checked to have changed the robot: a tag the robot lacks is added to the
-plugins that read it."""
+tricycle, hector IMU/GPS/magnetometer, range, sonar, bumper, Velodyne, block laser, multicamera, ft sensor, f3d,
+mimic joints, grasp fix): each value is refused with one line naming the tag, or runs without an exception, and a
+robot two metres away does not move by 1 mm. Every edit is checked to have changed the robot: a tag the robot lacks
+is added to the plugins that read it."""
 import math
 import os
 import re
@@ -216,6 +216,20 @@ def test_mimic_tags(tmp_path, tag, text):
 def test_urdf_mimic_attributes(tmp_path, attribute, text):
     mimic = f'<mimic joint="left_finger_joint" {attribute}="{text}"/>'
     assert_refused_or_harmless(run(tmp_path, MIMIC_GRIPPER.format(mimic=mimic, plugin="")), attribute, text)
+
+
+GRASP_FIX_TAGS = ["forces_angle_tolerance", "update_rate", "max_grip_count", "grip_count_threshold",
+                  "release_tolerance", "disable_collisions_on_attach"]
+GRASP_FIX_BLOCK = """<gazebo><plugin name="grasp_fix" filename="libgazebo_grasp_fix.so"><{tag}>{text}</{tag}>
+  <arm><arm_name>hand</arm_name><palm_link>palm</palm_link><gripper_link>left_finger</gripper_link>
+    <gripper_link>right_finger</gripper_link></arm></plugin></gazebo>"""
+
+
+@pytest.mark.parametrize("text", TAG_TEXTS)
+@pytest.mark.parametrize("tag", GRASP_FIX_TAGS)
+def test_grasp_fix_tags(tmp_path, tag, text):
+    urdf = MIMIC_GRIPPER.format(mimic="", plugin=GRASP_FIX_BLOCK.format(tag=tag, text=text))
+    assert_refused_or_harmless(run(tmp_path, urdf), tag, text)
 
 
 def test_every_tag_edit_changes_the_robot(velodyne_urdf, drives, tricycle, stereo_head):

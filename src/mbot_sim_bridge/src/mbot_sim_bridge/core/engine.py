@@ -49,6 +49,10 @@ PENETRATION_TOLERANCE = 1.0e-5  # m
 MAX_WHEEL_MU = 1.0e3
 # PyBullet's own number of solver iterations (ODE's <iters> default is the same).
 DEFAULT_SOLVER_ITERATIONS = 50
+# Gazebo's default contact stiffness (SDF <kp>): a spring this stiff is a rigid contact.
+RIGID_CONTACT_STIFFNESS = 1.0e12  # N/m
+# A finger without mass (a massless link) is damped as one of a gram.
+_MIN_SQUEEZING_MASS = 1.0e-3  # kg
 # PyBullet's bodies hold at most this many links, the base included: with more, loadURDF builds a body whose
 # every query fails ("GetBasePositionAndOrientation failed").
 MAX_BODY_LINKS = 128
@@ -316,6 +320,8 @@ class Engine:
         self.steps = 0
         # Sim time at step 0 of the current step size: set_physics_properties changes the step size mid-run.
         self.time_offset = 0.0
+        # How many times the world was built again (restart): PyBullet then numbers bodies and constraints anew.
+        self.rebuilds = 0
         self.robots: Dict[str, SpawnedRobot] = {}
         self.world_bodies: Dict[str, int] = {}
         self.dynamic_world_bodies: Dict[str, int] = {}  # those with mass, which the physics moves
@@ -359,6 +365,7 @@ class Engine:
         self._configure()
         self.steps = 0
         self.time_offset = 0.0
+        self.rebuilds += 1
         self.robots.clear()
         self.world_bodies.clear()
         self.dynamic_world_bodies.clear()
@@ -801,6 +808,25 @@ class Engine:
         # A wheel's friction is the wheel contact model's (wheel_contact), not Bullet's.
         self.client.changeDynamics(robot.body, index, lateralFriction=0.0 if caster or modelled else min(mu1, mu2),
                                    spinningFriction=0.0, rollingFriction=0.0, restitution=0.0)
+        stiffness = self._squeezing_contact(robot, link_name)
+        if stiffness is not None:
+            self.client.changeDynamics(robot.body, index, contactStiffness=stiffness[0], contactDamping=stiffness[1])
+
+    def _squeezing_contact(self, robot: SpawnedRobot, link_name: str) -> Optional[Tuple[float, float]]:
+        """(contact stiffness N/m, damping N·s/m) for a link on a prismatic joint (a gripper finger), else None.
+
+        ODE lets a contact rest within the world's contact_surface_layer uncorrected, so a finger pressed on a
+        box stands still in Gazebo. Bullet's rigid contacts push it out by the whole depth every step and it
+        reads effort·step/mass of velocity while it does not move (0.06 m/s at 30 N), so a gripper action never
+        stalls. As a spring (ODE's kp/kd, which Bullet combines per pair as ODE does) that holds the joint's
+        effort limit within the surface layer, critically damped for the link's mass, it rests (0 m/s)."""
+        joint = next((joint for joint in robot.model.joints.values() if joint.child == link_name), None)
+        layer = self.physics.contact_surface_layer
+        if joint is None or joint.type != "prismatic" or joint.effort <= 0.0 or layer <= 0.0:
+            return None
+        stiffness = min(joint.effort / layer, RIGID_CONTACT_STIFFNESS)
+        mass = max(robot.model.links[link_name].mass, _MIN_SQUEEZING_MASS)
+        return stiffness, 2.0 * math.sqrt(stiffness * mass)
 
     def _remember_initial_state(self, body: int):
         position, orientation = self.client.getBasePositionAndOrientation(body)

@@ -30,6 +30,7 @@ class PluginHost(Protocol):
     parameters: Parameters
     package_uris: Callable[[str], str]
     wrenches: BodyWrenches
+    call_in_loop: Callable[..., Any]
 
     @property
     def sim_time(self) -> float: ...
@@ -74,6 +75,15 @@ class PluginContext:
     def where(self, element: Optional[ElementTree.Element]) -> str:
         """'model NAME:LINE' for messages about an element of the model's description."""
         return self.model.robot.model.document.where(element)
+
+
+@dataclass
+class WorldPluginContext(PluginContext):
+    """A world plugin's context: ``model`` holds the world's name and its plugins, without a robot."""
+    path: str = ""
+
+    def where(self, element: Optional[ElementTree.Element]) -> str:
+        return f"world '{self.model.name}' ({self.path})"
 
 
 class Plugin:
@@ -177,3 +187,11 @@ class Plugin:
 
     def close(self):
         """The model is deleted or the simulation stops."""
+
+
+class WorldPlugin(Plugin):
+    """A Gazebo world plugin (``<plugin>`` inside ``<world>``, GZ_REGISTER_WORLD_PLUGIN): built once with the
+    world, told of the deletions of models it may hold on to."""
+
+    def model_deleted(self, name: str):
+        """Model ``name`` is about to be deleted."""

@@ -29,6 +29,8 @@ _REFERENCES: Dict[str, str] = {
     "libgazebo_ros_planar_move.so": "drives.planar_move.PlanarMove",
     "libgazebo_ros_force.so": "manipulation.force.Force",
     "libgazebo_ros_vacuum_gripper.so": "manipulation.vacuum_gripper.VacuumGripper",
+    "libgazebo_ros_link_attacher.so": "manipulation.link_attacher.LinkAttacher",
+    "libgazebo_grasp_fix.so": "manipulation.grasp_fix.GraspFix",
     "libgazebo_ros_skid_steer_drive.so": "drives.skid_steer_drive.SkidSteerDrive",
     "libgazebo_ros_tricycle_drive.so": "drives.tricycle_drive.TricycleDrive",
     "libhector_gazebo_ros_imu.so": "hector.hector_imu.HectorImu",

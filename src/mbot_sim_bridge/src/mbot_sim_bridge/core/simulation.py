@@ -28,7 +28,7 @@ from .joints.model_configuration import requested_positions
 from .lights import Lights, world_lights
 from .log import get_logger, warn_once
 from .parameters import Parameters
-from .plugin import Plugin, PluginContext, SpawnedModel
+from .plugin import Plugin, PluginContext, SpawnedModel, WorldPlugin, WorldPluginContext
 from .cameras.render_scene import RenderScene
 from .description.robot_model import RobotModel
 from .description.world_description import ArticulatedModel, ModelDescription, WorldDescription
@@ -70,6 +70,9 @@ class Simulation:
         self.seed = seed
         self.joint_state_rate = joint_state_rate
         self.paused = False
+        # How work a plugin's service asks for from another thread runs in the loop's thread: the node hands in
+        # its own (node.call_in_loop); without a node (tests, benches) the caller is the loop's thread.
+        self.call_in_loop: Callable[..., object] = lambda function, timeout=None: function()
         # Changes whenever models come or go or are moved from outside: what caches of their poses check.
         self.version = 0
         self.models: Dict[str, SpawnedModel] = {}
@@ -92,7 +95,12 @@ class Simulation:
         self._joint_limits: Dict[Tuple[str, str], Tuple[float, float]] = {}  # set by set_joint_properties
         self.lights = Lights(world_lights(world.others))
         self.sensor_updates: Dict[Plugin, int] = {}  # updates of each sensor plugin so far (performance_metrics)
+        # The world's own plugins, held as a model's are (their owner named after the world), built after its models.
+        self.world_plugins = SpawnedModel(world.name, "/", None)
         self.add_world(world)
+        self.world_plugins.plugins = [plugin for element in world.plugins
+                                      for plugin in self._create_world_plugin(element)]
+        self._schedule()
 
     # -- state -------------------------------------------------------------------------------------------------
     @property
@@ -199,6 +207,8 @@ class Simulation:
         for key in [key for key in self._property_undo if key[0] == name]:
             del self._property_undo[key]
         self._joint_limits = {key: value for key, value in self._joint_limits.items() if key[0] != name}
+        for plugin in list(self.world_plugins.plugins):
+            self._guarded(plugin, plugin.model_deleted, name)
 
     # -- wrenches from outside (apply_body_wrench) ---------------------------------------------------------------
     def apply_body_wrench(self, body: str, reference_frame: str, reference_point, force, torque, start_time: float,
@@ -533,6 +543,10 @@ class Simulation:
             warn_once(_logger, f"{where}: model '{spawned.name}': {what}plugin '{element.get('name')}' ({filename}) is "
                                "not emulated by the bridge; ignored")
             return []
+        if issubclass(plugin_class, WorldPlugin):
+            warn_once(_logger, f"{where}: model '{spawned.name}': {filename} is a world plugin (it goes inside "
+                               "<world>); ignored here, as Gazebo would not load it")
+            return []
         if bool(plugin_class.SENSOR_TYPES) != (sensor is not None):
             kind = "a sensor plugin (it goes inside a <sensor>)" if plugin_class.SENSOR_TYPES else "a model plugin"
             warn_once(_logger, f"{where}: model '{spawned.name}': {filename} is {kind}; ignored here, as "
@@ -545,9 +559,25 @@ class Simulation:
         context = PluginContext(self, spawned, link_name)
         return [plugin_class(context, element, sensor)]
 
+    def _create_world_plugin(self, element: ElementTree.Element) -> List[Plugin]:
+        """A ``<plugin>`` of the world, as Gazebo loads one: an unknown or model plugin is said once and left
+        out; one whose tags are wrong is refused with one error, and the world goes on without it."""
+        filename, where = element.get("filename", ""), f"{self.world.path}: world '{self.world.name}'"
+        plugin_class = self.registry.get(filename)
+        if plugin_class is None or not issubclass(plugin_class, WorldPlugin):
+            what = "is not emulated by the bridge" if plugin_class is None else "is not a world plugin"
+            warn_once(_logger, f"{where}: plugin '{element.get('name')}' ({filename}) {what}; ignored")
+            return []
+        try:
+            return [plugin_class(WorldPluginContext(self, self.world_plugins, path=self.world.path), element)]
+        except ConfigError as error:
+            _logger.error(f"{where}: plugin '{element.get('name')}' ({filename}) not loaded: {error}")
+            return []
+
     def _schedule(self):
         self._plugins = [plugin for name, spawned in self.models.items() if name not in self._frozen
                          for plugin in spawned.plugins]
+        self._plugins += self.world_plugins.plugins
         self._every_step_calls = [self._every_step_call(plugin) for plugin in self._plugins if plugin.needs_every_step]
         self._recording = [plugin for plugin in self._plugins if type(plugin).step_recorder is not Plugin.step_recorder]
 
@@ -668,7 +698,8 @@ class Simulation:
 
     def _disable(self, plugin: Plugin, error: Exception):
         """A plugin that raised: logged once, closed and dropped."""
-        _logger.error(f"model '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
+        owner = "world" if isinstance(plugin, WorldPlugin) else "model"
+        _logger.error(f"{owner} '{plugin.context.model.name}': plugin {plugin.label} failed and is disabled: "
                       f"{type(error).__name__}: {error}")
         _logger.debug(f"the failure of {plugin.label}", exc_info=error)
         plugin.context.model.plugins.remove(plugin)
@@ -750,5 +781,8 @@ class Simulation:
         for name in list(self.models):
             for plugin in self.models.pop(name).plugins:
                 plugin.close()
+        for plugin in self.world_plugins.plugins:
+            plugin.close()
+        self.world_plugins.plugins = []
         self._schedule()
         self.engine.close()

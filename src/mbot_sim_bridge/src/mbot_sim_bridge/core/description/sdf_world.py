@@ -5,7 +5,8 @@
 The result is a ``world_description.WorldDescription``; ``world_bodies.load_world`` turns its rigid models into
 PyBullet bodies; a model with joints, sensors or plugins is read as a robot instead (``sdf_model``), which the
 simulation spawns as URDF robots are. Visuals, lights, scene and GUI are left out; physics-relevant elements
-that are not simulated (world plugins, unknown geometry) warn once each, naming file and line.
+that are not simulated (unknown geometry) warn once each, naming file and line. The world's own plugins are
+kept for the Simulation, which builds them.
 """
 import dataclasses
 import os
@@ -46,9 +47,10 @@ BUILTIN_MODEL_NAMES = tuple(_BUILTIN_MODELS)
 # correcting velocity would throw bodies and a surface layer sink them (in Gazebo, and in a saved world).
 _CONSTRAINT_LIMITS = {"erp": 1.0, "contact_max_correcting_vel": 1.0e4, "contact_surface_layer": 0.1}
 # Children read elsewhere or without effect on contacts pass silently; unsupported and unknown ones warn once.
+# A world's <plugin>s are built by the Simulation (WorldDescription.plugins), which says which it lacks.
 _WORLD_IGNORED = {"audio", "wind", "gravity", "magnetic_field", "atmosphere", "gui", "physics", "scene", "light",
-                  "spherical_coordinates", "state", "frame", "road"}
-_WORLD_UNSUPPORTED = {"actor", "population", "plugin"}
+                  "spherical_coordinates", "state", "frame", "road", "plugin"}
+_WORLD_UNSUPPORTED = {"actor", "population"}
 _MODEL_IGNORED = {"static", "pose", "self_collide", "allow_auto_disable", "enable_wind", "frame"}
 _MODEL_UNSUPPORTED = {"gripper"}
 _MODEL_ARTICULATION = {"joint", "plugin"}  # such a model is simulated as a robot (sdf_model)

@@ -131,6 +131,11 @@ class WorldDescription:
     robots: Tuple[ArticulatedModel, ...] = ()
 
     @property
+    def plugins(self) -> Tuple[ET.Element, ...]:
+        """The world's ``<plugin>`` elements (world plugins), in order."""
+        return tuple(element for element in self.others if element.tag == "plugin")
+
+    @property
     def shapes(self) -> Tuple[Shape, ...]:
         """Every collision of every model, in the world frame."""
         return tuple(shape for model in self.models for shape in model.shapes)
