@@ -31,7 +31,7 @@ DRAG_TO = (1.5, 1.0)  # where the mouse lets the box go, in world x, y
 WALL_TIMEOUT = 180.0
 REST_SPEED = 1e-3  # m/s and rad/s: the box has come to rest
 STAYS_SECONDS = 1.0  # sim time it must then stay put for
-STAYS_TOLERANCE = 1e-3  # m and rad
+STAYS_TOLERANCE = 1e-4  # m and rad (measured: under 0.01 mm)
 # getMouseEvents' event types (PyBullet's quickstart guide; the module has no names for them).
 MOUSE_MOVE_EVENT, MOUSE_BUTTON_EVENT = 1, 2
 
