@@ -7,6 +7,7 @@ import subprocess
 from mbot_sim_bridge.processes import free_port, stop_process_group
 
 from ros_processes import TESTS, run, wait_until
+from xvfb import Xvfb
 
 MBOT = os.path.join(os.path.dirname(TESTS), "mbot")
 
@@ -104,3 +105,45 @@ def test_every_rviz_config_the_wrappers_open_exists():
     for config in configs:
         package = "rover_description" if config == "rover" else "mbot_description"
         assert os.path.isfile(os.path.join(packages.get_path(package), "config", config + ".rviz")), config
+
+
+def test_the_crate_worlds_start_and_sim_rviz_opens_rviz(tmp_path):
+    """The worlds no other test starts (mobile_test_robots' holonomic, tricycle and stereo), each through ./mbot sim
+    on a master of its own, side by side, up to its robot's first message; the holonomic one with --rviz, whose
+    rviz (on a private X display) subscribes /odom as mbot.rviz, the config ./mbot sim picks for it, says."""
+    first_messages = {"holonomic": "/odom", "tricycle": "/odom", "stereo": "/stereo/left/camera_info"}
+    with Xvfb(tmp_path / "xvfb.log") as server:
+        environments, simulations = {}, {}
+        try:
+            for world in first_messages:
+                (tmp_path / world).mkdir()  # its logs, and rviz's HOME (rviz writes ~/.rviz)
+                environments[world] = dict(_environment(tmp_path / world), DISPLAY=server.display,
+                                           LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path / world))
+                with open(tmp_path / world / "sim.log", "w") as log:
+                    simulations[world] = subprocess.Popen(
+                        [MBOT, "sim", world] + (["--rviz"] if world == "holonomic" else []),
+                        env=environments[world], stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+            for world, topic in first_messages.items():
+                wait_until(lambda: run(["rostopic", "echo", "-n", "1", "--noarr", topic], environments[world],
+                                       timeout=120).returncode == 0,
+                           180, f"{topic} from ./mbot sim {world} (log: {tmp_path / world / 'sim.log'})")
+            wait_until(lambda: rviz_subscribes(environments["holonomic"], "/odom"), 120,
+                       f"rviz to subscribe /odom (log: {tmp_path / 'holonomic' / 'sim.log'})")
+            for world, simulation in simulations.items():
+                assert simulation.poll() is None, (tmp_path / world / "sim.log").read_text()
+                os.killpg(simulation.pid, signal.SIGINT)
+            for world, simulation in simulations.items():
+                assert simulation.wait(timeout=60) == 0, (tmp_path / world / "sim.log").read_text()
+        finally:
+            for simulation in simulations.values():
+                stop_process_group(simulation)
+
+
+def rviz_subscribes(environment, topic):
+    """Whether a node of rviz's (rosrun rviz rviz names itself /rviz_HOST_PID) subscribes ``topic``."""
+    import rosgraph
+    try:
+        _, subscribers, _ = rosgraph.Master("/test", master_uri=environment["ROS_MASTER_URI"]).getSystemState()
+    except (rosgraph.MasterError, OSError):
+        return False
+    return any(node.startswith("/rviz") for name, nodes in subscribers if name == topic for node in nodes)

@@ -1,8 +1,8 @@
 """Arranging with the mouse in the simulator window: PyBullet's own picking (left button on a body, drag).
 
-A dynamic model dragged there stays where it is let go (then obeys gravity, as in Gazebo), the engine reports
-its new pose (what get_model_state and /gazebo/model_states read) and a saved world holds it. A static model
-has mass 0, which PyBullet cannot pick: it stays put (./mbot move places static models).
+A dynamic model dragged there hangs from the mouse on PyBullet's pick spring; let go, it falls, comes to rest and
+stays there, the engine reports its new pose (what get_model_state and /gazebo/model_states read) and a saved world
+holds it. A static model has mass 0, which PyBullet cannot pick: it stays put (./mbot move places static models).
 The simulation runs in this process (a Simulation in PyBullet's GUI mode) so the test can aim the mouse with the
 window's camera; xdotool presses and moves the mouse on a private Xvfb display.
 """
@@ -10,13 +10,12 @@ import gc
 import math
 import os
 import subprocess
-import threading
 import time
 
 import numpy as np
 import pybullet
 import pytest
-from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy
+from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
@@ -26,10 +25,15 @@ from xvfb import Xvfb
 
 WORLDS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "worlds")
 DRAG_TO = (1.5, 1.0)  # where the mouse lets the box go, in world x, y
-WALL_SECONDS = 8.0  # the simulation steps at least this long while the mouse works
-# With the button still down at the end of a drag, the box gets this many steps to catch up with the mouse: counted
-# in steps, not wall time, because a loaded machine steps the simulation far fewer times a second.
-HOLD_STEPS = 2000
+# Every wait below is on a condition checked between simulation steps, with a wall-time limit only for failure:
+# a loaded machine steps and draws far fewer times a second (in GUI mode every PyBullet call waits for the
+# window's thread: under a load of 15 on 2 cores a second of sim time took 25 s).
+WALL_TIMEOUT = 180.0
+REST_SPEED = 1e-3  # m/s and rad/s: the box has come to rest
+STAYS_SECONDS = 1.0  # sim time it must then stay put for
+STAYS_TOLERANCE = 1e-4  # m and rad (measured: under 0.01 mm)
+# getMouseEvents' event types (PyBullet's quickstart guide; the module has no names for them).
+MOUSE_MOVE_EVENT, MOUSE_BUTTON_EVENT = 1, 2
 
 
 def insert(simulation, tmp_path, database_name, name, x, y):
@@ -60,20 +64,42 @@ def xdotool(display, *arguments):
     subprocess.run(["xdotool", *arguments], env=dict(os.environ, DISPLAY=display), check=True, timeout=10)
 
 
-def drag(display, start, end, steps):
-    """Press on ``start``, move to ``end``, and let go once the simulation has stepped HOLD_STEPS more
-    (``steps()`` counts them) or a minute has passed."""
-    xdotool(display, "mousemove", *map(str, start))
-    time.sleep(0.3)
-    xdotool(display, "mousedown", "1")
-    time.sleep(0.3)
-    for step in range(1, 31):
-        xdotool(display, "mousemove", *(str(a + (b - a) * step // 30) for a, b in zip(start, end)))
-        time.sleep(0.05)
-    held_from, deadline = steps(), time.monotonic() + 60.0
-    while steps() - held_from < HOLD_STEPS and time.monotonic() < deadline:
-        time.sleep(0.05)
-    xdotool(display, "mouseup", "1")
+class Mouse:
+    """The mouse on the window, each action awaited until the window reports it (getMouseEvents), with the
+    simulation stepping meanwhile: PyBullet picks and drags bodies as the window handles the events."""
+
+    def __init__(self, simulation, display):
+        self.simulation, self.display = simulation, display
+        self.client = simulation.engine.client
+
+    def step_until(self, condition, what):
+        deadline = time.monotonic() + WALL_TIMEOUT
+        while not condition():
+            assert time.monotonic() < deadline, f"timed out after {WALL_TIMEOUT:g} s waiting for {what}"
+            self.simulation.step(5)
+            time.sleep(0.002)  # the window's thread gets the lock between steps
+
+    def events_until(self, wanted, what):
+        self.step_until(lambda: any(wanted(event) for event in self.client.getMouseEvents()), what)
+
+    def move(self, pixel):
+        xdotool(self.display, "mousemove", *map(str, pixel))
+        self.events_until(lambda event: event[0] == MOUSE_MOVE_EVENT and event[1:3] == tuple(pixel),
+                          f"the window to see the mouse at {pixel}")
+
+    def button(self, action, state):
+        xdotool(self.display, action, "1")
+        self.events_until(lambda event: event[0] == MOUSE_BUTTON_EVENT and event[3] == 0 and event[4] & state,
+                          f"the window to see {action}")
+
+    def drag(self, start, end, held_until, what):
+        """Press on ``start``, move to ``end`` in steps, and let go once ``held_until()`` holds."""
+        self.move(start)
+        self.button("mousedown", pybullet.KEY_WAS_TRIGGERED)
+        for step in range(1, 11):
+            self.move(tuple(a + (b - a) * step // 10 for a, b in zip(start, end)))
+        self.step_until(held_until, what)
+        self.button("mouseup", pybullet.KEY_WAS_RELEASED)
 
 
 @pytest.fixture
@@ -98,6 +124,11 @@ def window_simulation(tmp_path):
             simulation.close()
 
 
+def at_rest(simulation, name):
+    linear, angular = simulation.engine.model_velocity(name)
+    return np.linalg.norm(linear) < REST_SPEED and np.linalg.norm(angular) < REST_SPEED
+
+
 def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulation, tmp_path):
     simulation, server = window_simulation
     insert(simulation, tmp_path, "unit_box", "unit_box", 0.0, 0.0)
@@ -106,35 +137,36 @@ def test_a_dragged_box_stays_where_it_is_left_and_is_saved_there(window_simulati
     client = simulation.engine.client
     box_start = simulation.engine.model_pose("unit_box").position
     table_start = simulation.engine.model_pose("cafe_table")
-    drags = [(window_pixel(client, (-1.5, -1.0, 0.755)), window_pixel(client, (-1.5, 1.0, 0.755))),  # the table
-             (window_pixel(client, (0.0, 0.0, 1.0)), window_pixel(client, (*DRAG_TO, 1.0)))]  # the box's top
+    mouse = Mouse(simulation, server.display)
 
-    def mouse_work():
-        for start, end in drags:
-            drag(server.display, start, end, lambda: simulation.engine.steps)
-    mouse = threading.Thread(target=mouse_work)
-    mouse.start()
-    started = time.monotonic()
-    while time.monotonic() - started < WALL_SECONDS or mouse.is_alive():
-        simulation.step(5)  # PyBullet applies the picking constraint as the simulation steps
-        time.sleep(0.002)
-    mouse.join()
-    # Let go, it comes to rest: wherever that is, it is far from the start, towards where the mouse went.
-    for _ in range(100):
-        simulation.step(100)
-        linear, angular = simulation.engine.model_velocity("unit_box")
-        if np.linalg.norm(linear) < 1e-3 and np.linalg.norm(angular) < 1e-3:
-            break
-    box = simulation.engine.model_pose("unit_box")
-    moved = math.dist(box.position[:2], box_start[:2])
-    assert moved > 0.5, f"the box moved {moved:.3f} m"
-    assert np.dot(np.subtract(box.position[:2], box_start[:2]), DRAG_TO) > 0
-    # The static table cannot be picked: the drag on it left it where it was.
+    # The static table cannot be picked: a drag on it, held 0.1 s, leaves it where it was.
+    held_from = simulation.sim_time
+    mouse.drag(window_pixel(client, (-1.5, -1.0, 0.755)), window_pixel(client, (-1.5, 1.0, 0.755)),
+               lambda: simulation.sim_time > held_from + 0.1, "0.1 s of sim time")
     assert simulation.engine.model_pose("cafe_table") == table_start
+
+    # The box, picked on its top, hangs from the mouse on PyBullet's pick spring and circles under it at 6 to 8 m/s
+    # while the button is down (measured over 1.5 s), so wherever it is let go it is thrown: let go once it has
+    # been carried a metre, it lands 3 to 6 m away (measured) and comes to rest, then stays there.
+    def carried():
+        return math.dist(simulation.engine.model_pose("unit_box").position[:2], box_start[:2]) > 1.0
+    mouse.drag(window_pixel(client, (0.0, 0.0, 1.0)), window_pixel(client, (*DRAG_TO, 1.0)), carried,
+               "the box to follow the mouse a metre")
+    mouse.step_until(lambda: at_rest(simulation, "unit_box"), "the box to come to rest")
+    box = simulation.engine.model_pose("unit_box")
+    rest_time = simulation.sim_time
+    mouse.step_until(lambda: simulation.sim_time >= rest_time + STAYS_SECONDS, f"{STAYS_SECONDS} s of sim time")
+    stayed = simulation.engine.model_pose("unit_box")
+    moved = math.dist(box.position[:2], box_start[:2])
+    print(f"figure: dragged box left at ({box.position[0]:.3f}, {box.position[1]:.3f}) m, {moved:.3f} m from its "
+          f"start; it moved {math.dist(stayed.position, box.position) * 1000:.3f} mm in the {STAYS_SECONDS:g} s after")
+    assert moved > 0.5 and np.dot(np.subtract(box.position[:2], box_start[:2]), DRAG_TO) > 0
+    assert math.dist(stayed.position, box.position) < STAYS_TOLERANCE
+    assert abs(math.remainder(yaw(stayed.orientation) - yaw(box.orientation), 2 * math.pi)) < STAYS_TOLERANCE
 
     snapshot = take_snapshot(simulation, with_robots=False)
     path = tmp_path / "dragged.world"
     write_world_file(str(path), world_sdf(parse_world(os.path.join(WORLDS, "empty.world")), snapshot.models,
                                           snapshot.poses))
     (saved,) = [model for model in parse_world(str(path)).models if model.name == "unit_box"]
-    assert math.dist(saved.pose.position, box.position) < 1e-3
+    assert math.dist(saved.pose.position, stayed.position) < 1e-3

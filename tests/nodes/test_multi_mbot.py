@@ -96,15 +96,17 @@ class MultiMbot(unittest.TestCase):
         rates = {robot: 0.1 * (index + 1) * (-1) ** index for index, robot in enumerate(ROBOTS)}
         publishers = {robot: rospy.Publisher(f"/{robot}/cmd_vel", Twist, queue_size=1, latch=True)
                       for robot in ROBOTS}
-        for robot, publisher in publishers.items():
-            wait_for(lambda: publisher.get_num_connections() > 0, what=f"/{robot}/cmd_vel subscribed")
-            command = Twist()
-            command.angular.z = rates[robot]
-            publisher.publish(command)
-        wait_for(lambda: all(abs(self.odom[robot].twist.twist.angular.z - rates[robot]) < 0.02 for robot in ROBOTS),
-                 what="every robot turning at its own rate")
-        for publisher in publishers.values():
-            publisher.publish(Twist())
+        try:
+            for robot, publisher in publishers.items():
+                wait_for(lambda: publisher.get_num_connections() > 0, what=f"/{robot}/cmd_vel subscribed")
+                command = Twist()
+                command.angular.z = rates[robot]
+                publisher.publish(command)
+            wait_for(lambda: all(abs(self.odom[robot].twist.twist.angular.z - rates[robot]) < 0.02
+                                 for robot in ROBOTS), what="every robot turning at its own rate")
+        finally:  # stopped whatever happened: the scan test waits for every robot at rest
+            for publisher in publishers.values():
+                publisher.publish(Twist())
         turning = ", ".join(f"{rate:.1f}" for rate in rates.values())
         print(f"figure: {COUNT} robots turning at {turning} rad/s on their own cmd_vel")
 

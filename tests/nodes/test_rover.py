@@ -16,7 +16,7 @@ import unittest
 import rospy
 import rostest
 from gazebo_msgs.msg import ContactsState
-from gazebo_msgs.srv import ApplyBodyWrench, GetModelState, SpawnModel
+from gazebo_msgs.srv import ApplyBodyWrench, DeleteModel, GetModelState, SpawnModel
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
@@ -96,7 +96,8 @@ class Rover(unittest.TestCase):
         publish_for(sim_seconds, (publisher or self.cmd_vel, command))
 
     def test_01_imu_reads_gravity_up_at_rest(self):
-        # Half a second of readings (50 Hz) once the rover has settled after its landing.
+        # Half a second of readings (50 Hz) once the rover stands still (after its landing, or a drive).
+        wait_for(lambda: self.at_rest(), what="the rover at rest")
         start = rospy.Time.now() + rospy.Duration(0.2)
         readings = wait_for(lambda: len(self.imu.since(start)) >= 25 and self.imu.since(start),
                             what="25 /imu/data messages at rest")
@@ -173,6 +174,9 @@ class Rover(unittest.TestCase):
         crate.position.z, crate.orientation.w = CRATE_SIZE[2] / 2, 1.0
         spawn = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)
         self.assertTrue(spawn("crate", CRATE_SDF, "", crate, "world").success)
+        # Whatever happens, the crate goes again (the sonar test reads max_range in the open), after the base
+        # has stopped (cleanups run last first).
+        self.addCleanup(rospy.ServiceProxy("/gazebo/delete_model", DeleteModel), "crate")
         spawned = rospy.Time.now()
         front = Latest("/holonomic/sonar_front", Range)
         wait_for(lambda: len(front.since(spawned)) >= 5, what="five sonar readings of the crate")
@@ -183,6 +187,7 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(median, CRATE_GAP, delta=0.01)
 
         command = rospy.Publisher("/holonomic/cmd_vel", Twist, queue_size=1)
+        self.addCleanup(self.drive, 0.0, 0.3, command)
         twist = Twist()
         twist.linear.x = 0.5
 
@@ -190,7 +195,6 @@ class Rover(unittest.TestCase):
             command.publish(twist)
             return next((state for message in bumper.since(spawned) for state in message.states), None)
         state = wait_for(touching, what="the bumper to touch the crate")
-        self.drive(0.0, 0.3, command)
         collisions = (state.collision1_name, state.collision2_name)
         normal = state.contact_normals[0]
         self.figures.append(f"holonomic bumper: {collisions[0]} against {collisions[1]}, {len(state.contact_normals)} "
@@ -204,6 +208,9 @@ class Rover(unittest.TestCase):
         command = rospy.Publisher("/skid/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/skid/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the skid steer plugin")
+        # The plugin keeps its last command (no timeout, as upstream's): stopped again whatever happens, so it
+        # does not drive on into the other robots during the later tests.
+        self.addCleanup(self.drive, 0.0, 0.3, command)
         self.drive(0.5, 1.5, command)
         state = self.get_model_state("skid_steer_base", "world")
         reported = odometry.message.twist.twist.linear.x
@@ -217,6 +224,7 @@ class Rover(unittest.TestCase):
         command = rospy.Publisher("/tricycle/cmd_vel", Twist, queue_size=1)
         odometry = Latest("/tricycle/odom", Odometry)
         wait_for(lambda: command.get_num_connections() > 0 and odometry.message, what="the tricycle plugin")
+        self.addCleanup(self.drive, 0.0, 0.3, command)  # it too keeps its last command
         twist = Twist()
         twist.linear.x, twist.angular.z = 0.4, 0.3  # wheel speed, steering angle
         start = rospy.get_time()
@@ -234,7 +242,6 @@ class Rover(unittest.TestCase):
         self.assertEqual(joints.name, ["front_steering_joint", "front_wheel_joint", "left_wheel_joint",
                                        "right_wheel_joint"])
         self.assertAlmostEqual(joints.position[0], 0.3, delta=0.005)
-        command.publish(Twist())
 
     def test_09_tricycle_block_laser_sees_the_ground(self):
         cloud = rospy.wait_for_message("/tricycle/block_cloud", PointCloud, timeout=WALL_TIMEOUT)
@@ -286,6 +293,11 @@ class Rover(unittest.TestCase):
         self.assertIn("ApplyBodyWrench: body does not exist", refused.status_message)
 
     def test_12_ft_sensor_reads_the_head_weight(self):
+        def head_at_rest():  # an applied wrench (test_11) sets the head moving for a while
+            twist = self.get_model_state("stereo_head", "world").twist
+            return math.hypot(twist.linear.x, twist.linear.y, twist.linear.z, twist.angular.x, twist.angular.y,
+                              twist.angular.z) < 1e-3
+        wait_for(head_at_rest, what="the stereo head at rest")
         reading = rospy.wait_for_message("/stereo_head/pan_wrench", WrenchStamped, timeout=WALL_TIMEOUT)
         force = reading.wrench.force
         self.figures.append(f"stereo head pan ft sensor: force ({force.x:.3f}, {force.y:.3f}, {force.z:.3f}) N for the "

@@ -123,9 +123,10 @@ class Tour:
     machine and its messages are."""
 
     def __init__(self, sim: LockstepClient, recorder: Recorder, step_size: float, on_terminal: bool,
-                 segment_sim_timeout: float = SEGMENT_SIM_TIMEOUT):
+                 segment_sim_timeout: float = SEGMENT_SIM_TIMEOUT, sim_seconds: float = math.inf):
         self.sim = sim
         self.segment_sim_timeout = segment_sim_timeout
+        self.sim_seconds = sim_seconds  # the tour ends there, wherever it is
         self.recorder = recorder
         self.control_steps = max(1, round(CONTROL_PERIOD / step_size))
         self.control_period = self.control_steps * step_size
@@ -159,7 +160,7 @@ class Tour:
     def wait(self, done, what):
         start = self.pose[0]
         wall_deadline = time.monotonic() + WALL_TIMEOUT
-        while not done(self.pose):
+        while not done(self.pose) and self.pose[0] < self.sim_seconds:
             if self.pose[0] - start > self.segment_sim_timeout or time.monotonic() > wall_deadline:
                 raise RuntimeError(f"the robot did not finish '{what}' (stuck at x {self.pose[1]:.2f}, "
                                    f"y {self.pose[2]:.2f})")
@@ -171,6 +172,8 @@ class Tour:
             self.advance()
         heading = self.pose[3]
         for kind, amount in TOUR:
+            if self.pose[0] >= self.sim_seconds:
+                break
             _, x0, y0, _ = self.pose
             if kind == "forward":
                 def forward(pose):
@@ -200,8 +203,14 @@ def main(argv=None):
                         help="instead of the tour: the arm follows a trajectory, drawn to out/arm.png")
     parser.add_argument("--pick", action="store_true",
                         help="instead of the tour: the arm picks a box and places it, drawn to out/pick.png")
+    parser.add_argument("--sim-seconds", type=float, default=math.inf,
+                        help="end the tour after this much sim time, wherever it is (a short look)")
     parser.add_argument("--out", help="picture to write (default out/demo.png, out/arm.png or out/pick.png)")
     args = parser.parse_args(argv)
+    if not args.sim_seconds > 0:
+        parser.error(f"--sim-seconds must be a positive number of seconds, not {args.sim_seconds}")
+    if (args.arm or args.pick) and args.sim_seconds != math.inf:
+        parser.error(f"--sim-seconds shortens the tour; --{'arm' if args.arm else 'pick'} runs to its end")
     picture = "arm.png" if args.arm else "pick.png" if args.pick else "demo.png"
     args.out = args.out or os.path.join(os.getcwd(), "out", picture)
     if args.arm:
@@ -283,7 +292,8 @@ def tour_and_draw(args, world_path, started, log_dir):
     try:
         sim = LockstepClient(timeout=STARTUP_TIMEOUT)
         recorder = Recorder(sim)
-        tour = Tour(sim, recorder, world.physics.max_step_size, on_terminal=sys.stderr.isatty())
+        tour = Tour(sim, recorder, world.physics.max_step_size, on_terminal=sys.stderr.isatty(),
+                    sim_seconds=args.sim_seconds)
     except (rospy.ROSException, RuntimeError) as error:
         print(f"mbot demo: the simulator did not come up: {error} (see the log)", file=sys.stderr)
         return 1

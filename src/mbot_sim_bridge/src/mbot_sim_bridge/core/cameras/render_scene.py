@@ -3,6 +3,7 @@ render of colour and depth from a sensor pose."""
 import os
 import pkgutil
 import tempfile
+import weakref
 from dataclasses import dataclass
 from typing import Dict, Optional, Tuple
 
@@ -22,16 +23,17 @@ BACKGROUND_RGB = (178, 178, 178)
 # Environment choice of the renderer: "tiny" (default) or "egl" (the bench compares them).
 RENDERER_ENV = "MBOT_CAMERA_RENDERER"
 
-_egl_loaded: Dict[int, bool] = {}
+# Whether the EGL plugin loaded, per client object: PyBullet hands a disconnected client's number to the next
+# client, which has no plugin (keyed by number, a later client rendered with TinyRenderer while called 'egl').
+_egl_loaded: "weakref.WeakKeyDictionary[object, bool]" = weakref.WeakKeyDictionary()
 
 
 def choose_renderer(client) -> str:
     """'tiny' (PyBullet's TinyRenderer, the default) or 'egl' when asked for with MBOT_CAMERA_RENDERER=egl.
 
-    The EGL plugin (PyBullet's OpenGL renderer on the platform's GL, here Mesa's llvmpipe) is faster on an
-    idle machine at 640x480 and above, but it does not draw the same picture: PyBullet resamples its
-    framebuffer to the requested size, which moves things by up to 2 px at 640x480 and 5 px at 1280x720 from
-    where CameraInfo puts them, and it never sees bodies created before it was loaded. The bench measures both.
+    The EGL plugin (PyBullet's OpenGL renderer on the platform's GL, here Mesa's llvmpipe) puts things within a
+    pixel of where CameraInfo says, as TinyRenderer does (test_camera), but it never sees bodies created before
+    it was loaded into the client. The bench measures the speed of both.
     """
     wanted = os.environ.get(RENDERER_ENV, "tiny").strip().lower()
     if wanted not in ("egl", "tiny"):
@@ -39,14 +41,13 @@ def choose_renderer(client) -> str:
         wanted = "tiny"
     if wanted == "tiny" or client.getConnectionInfo().get("connectionMethod") == pybullet.GUI:
         return "tiny"
-    key = client._client
-    if key not in _egl_loaded:
+    if client not in _egl_loaded:
         loader = pkgutil.get_loader("eglRenderer")
         plugin = client.loadPlugin(loader.get_filename(), "_eglRendererPlugin") if loader is not None else -1
-        _egl_loaded[key] = plugin >= 0
+        _egl_loaded[client] = plugin >= 0
         if plugin < 0:
             info_once(_log, "PyBullet's EGL renderer did not load; cameras use TinyRenderer")
-    return "egl" if _egl_loaded[key] else "tiny"
+    return "egl" if _egl_loaded[client] else "tiny"
 
 
 class RenderScene:
