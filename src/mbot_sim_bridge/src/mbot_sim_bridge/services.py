@@ -138,7 +138,7 @@ class GazeboRosApi:
             rospy.Service("~get_light_properties", GetLightProperties, self._get_light_properties),
             rospy.Service("~set_light_properties", SetLightProperties, self._set_light_properties),
             rospy.Service("~delete_light", DeleteLight, self._delete_light),
-            # The bridge's own; the loaded world's description is read again for its lights, scene and name.
+            # The bridge's own; the loaded world's description gives its name, scene and other elements.
             rospy.Service("~save_world", SaveWorld, SaveWorldHandler(self.sim.world, self.sim, node.call_in_loop)),
         ]
 

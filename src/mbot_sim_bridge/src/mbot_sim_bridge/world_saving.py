@@ -20,8 +20,8 @@ PLUGINS_AS_TAGS = ("robots are written as inline SDF models; their plugins are k
 
 class SaveWorldHandler:
     """The ``~save_world`` handler: ``rospy.Service("~save_world", SaveWorld, SaveWorldHandler(world, sim,
-    node.call_in_loop))``. ``world`` is the description the simulation was loaded from (its name, lights and
-    scene are written back); ``simulation`` a core Simulation, read only through ``call_in_loop``."""
+    node.call_in_loop))``. ``world`` is the description the simulation was loaded from (its name, scene and
+    other elements are written back; lights and physics as they are now); ``simulation`` a core Simulation, read only through ``call_in_loop``."""
 
     def __init__(self, world: WorldDescription, simulation, call_in_loop: Callable):
         self.world = world
@@ -42,7 +42,7 @@ class SaveWorldHandler:
             raise WorldError(f"path '{path}' is not absolute (the simulator's working directory is not the caller's)")
         snapshot: WorldSnapshot = self.call_in_loop(lambda: take_snapshot(self.simulation, with_robots))
         write_world_file(path, world_sdf(self.world, snapshot.models, snapshot.poses, snapshot.robots,
-                                         snapshot.link_states))
+                                         snapshot.link_states, snapshot.physics, snapshot.lights))
         left_out = [] if with_robots else snapshot.robot_names
         message = f"wrote {path}: {len(snapshot.models) + len(snapshot.robots)} models"
         if left_out:

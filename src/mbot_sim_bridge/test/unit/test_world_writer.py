@@ -14,6 +14,7 @@ from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.description.world_description import PhysicsConfig
+from mbot_sim_bridge.core.lights import SUN, world_lights
 from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.core.description.world_writer import pose_text, take_snapshot, world_sdf, write_world_file
 
@@ -53,7 +54,7 @@ def save_and_reload(simulation, world, tmp_path, with_robots=False, name="saved.
     snapshot = take_snapshot(simulation, with_robots)
     path = tmp_path / name
     write_world_file(str(path), world_sdf(world, snapshot.models, snapshot.poses, snapshot.robots,
-                                          snapshot.link_states))
+                                          snapshot.link_states, snapshot.physics, snapshot.lights))
     return snapshot, path, parse_world(str(path), default_model_path())
 
 
@@ -115,6 +116,31 @@ def test_physics_settings_are_written(tmp_path):
     _, path, reloaded = save_and_reload(simulation, world, tmp_path)
     assert reloaded.physics == physics
     check_sdf_1_6_structure(path)
+    simulation.close()
+
+
+def test_lights_and_physics_are_written_as_the_services_left_them(tmp_path):
+    path = tmp_path / "lit.world"
+    path.write_text("""<sdf version="1.6"><world name="default"><include><uri>model://sun</uri></include>
+      <light name="lamp" type="spot"><pose>1 2 3 0 0 0</pose><diffuse>0.5 0.4 0.3 1</diffuse></light>
+      <light name="spare" type="point"/></world></sdf>""")
+    world = parse_world(str(path))
+    simulation = Simulation(world, {})
+    simulation.set_physics(0.002, 250.0, (0.0, 0.0, -5.0), simulation.ode_config()._replace(erp=0.4))
+    sun = SUN._replace(diffuse=(0.1, 0.2, 0.3, 1.0), pose=pose_from_xyz_rpy((0.0, 1.0, 9.0), (0.0, 0.5, 0.0)))
+    simulation.lights.set("sun", sun.cast_shadows, sun.diffuse, sun.specular, sun.attenuation, sun.direction,
+                          sun.pose)
+    simulation.lights.delete("spare")
+    lights_now = dict(simulation.lights.lights)
+    _, saved, reloaded = save_and_reload(simulation, world, tmp_path)
+    assert reloaded.physics == simulation.engine.physics
+    assert (reloaded.physics.max_step_size, reloaded.physics.gravity, reloaded.physics.erp) == (0.002, (0, 0, -5), 0.4)
+    relit = world_lights(reloaded.others)
+    assert relit.keys() == {"sun", "lamp"}
+    assert relit["lamp"] == lights_now["lamp"]  # unchanged: copied as read
+    assert relit["sun"].diffuse == sun.diffuse and relit["sun"].type == "directional"
+    assert_same_pose(relit["sun"].pose, sun.pose, "the moved sun")
+    check_sdf_1_6_structure(saved)
     simulation.close()
 
 

@@ -43,18 +43,22 @@ SUN = Light("directional", True, (0.8, 0.8, 0.8, 1.0), (0.2, 0.2, 0.2, 1.0), (0.
 
 def world_lights(elements: Sequence[ElementTree.Element]) -> Dict[str, Light]:
     """The lights among a world's other children (WorldDescription.others), by name."""
-    lights = {}
-    for element in elements:
-        if element.tag == "light":
-            lights[element.get("name", "")] = _read(element, SDF_LIGHT._replace(type=element.get("type", "point")))
-        elif element.tag == "include" and (element.findtext("uri") or "").strip().rstrip("/") == "model://sun":
-            lights[(element.findtext("name") or "sun").strip()] = _read(element, SUN)
-    return lights
+    return {name: read_light(element) for element in elements for name in [light_name(element)] if name is not None}
 
 
-def _read(element: ElementTree.Element, light: Light) -> Light:
-    """``light`` with what ``element`` (a <light>, or an <include>'s name and pose) sets; a bad value is said once
-    and the default kept."""
+def light_name(element: ElementTree.Element) -> Optional[str]:
+    """The name of the light a world's child is (a <light>, or an <include> of model://sun), else None."""
+    if element.tag == "light":
+        return element.get("name", "")
+    if element.tag == "include" and (element.findtext("uri") or "").strip().rstrip("/") == "model://sun":
+        return (element.findtext("name") or "sun").strip()
+    return None
+
+
+def read_light(element: ElementTree.Element) -> Light:
+    """The light a <light> or model://sun <include> describes, with SDF's or the sun's defaults for what it leaves
+    out; a bad value is said once and the default kept."""
+    light = SUN if element.tag == "include" else SDF_LIGHT._replace(type=element.get("type", "point"))
     def read(path: str, parse, default, what: str):
         text = element.findtext(path)
         if text is None:

@@ -6,8 +6,9 @@ whose poses in the model frame do not change. A model with joints is written as 
 stand now goes, as Gazebo saves it, into the world's ``<state>``: the world pose of each of its links (SDF has
 no joint position in a model, and Gazebo's ModelState writes links only); reading the file sets the joints
 from those poses.
-Lights, scene and the other non-model world elements are copied; physics and gravity come from the
-settings in use. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
+Scene and the other non-model world elements are copied. Physics, gravity and lights are written as they
+are now: set_physics_properties' settings, and each light as read unless set_light_properties changed it (then
+a ``<light>`` with its values now, the sun's include too) or delete_light removed it. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
 converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
 Model poses are written as world poses, so world ``<frame>``s are not needed and not written. The file is
 SDF 1.6, or 1.7 when a model written back uses 1.7's ``relative_to``/``attached_to`` frames.
@@ -22,6 +23,7 @@ from typing import Dict, Iterable, List, Mapping, NamedTuple, Optional, Sequence
 
 from ..errors import WorldError
 from ..geometry import Pose, compose, inverse, rpy
+from ..lights import Light, light_name, read_light
 from .robot_model import BALL_JOINT_TYPE, RobotModel
 from .world_description import ArticulatedModel, ModelDescription, PhysicsConfig, WorldDescription
 
@@ -48,6 +50,8 @@ class WorldSnapshot(NamedTuple):
     robots: List[SavedRobot]  # URDF robots, with the world pose of every URDF link now (when asked for)
     robot_names: List[str]  # every robot spawned from URDF, written or not
     link_states: Dict[str, Dict[str, Pose]]  # model with joints -> world pose of each of its links now
+    physics: PhysicsConfig  # the settings in use
+    lights: Dict[str, Light]  # the world's lights now, by name
 
 
 def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
@@ -70,7 +74,8 @@ def take_snapshot(simulation, with_robots: bool) -> WorldSnapshot:
             robot = spawned.robot
             links = {link: robot.link_world_pose(link) for link in robot.model.lumped_into}
             robots.append(SavedRobot(name, robot.model, links))
-    return WorldSnapshot(models, poses, robots, urdf_robots, link_states)
+    return WorldSnapshot(models, poses, robots, urdf_robots, link_states, engine.physics,
+                         dict(simulation.lights.lights))
 
 
 def pose_text(pose: Pose) -> str:
@@ -87,14 +92,21 @@ def _number(value: float) -> str:
 
 def world_sdf(world: WorldDescription, models: Sequence[Union[ModelDescription, ArticulatedModel]],
               poses: Mapping[str, Pose], robots: Sequence[SavedRobot] = (),
-              link_states: Optional[Mapping[str, Mapping[str, Pose]]] = None) -> str:
-    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world), ``robots``, and
-    ``link_states`` (world link poses of models with joints) as a ``<state>``."""
+              link_states: Optional[Mapping[str, Mapping[str, Pose]]] = None,
+              physics: Optional[PhysicsConfig] = None, lights: Optional[Mapping[str, Light]] = None) -> str:
+    """The SDF text of ``world``'s settings with ``models`` at ``poses`` (model frames, world), ``robots``,
+    ``link_states`` (world link poses of models with joints) as a ``<state>``, and ``physics`` and ``lights`` as
+    they are now (None: as ``world`` has them)."""
     root = ET.Element("sdf", version=SDF_VERSION)
     element = ET.SubElement(root, "world", name=world.name)
     for other in world.others:
-        element.append(copy.deepcopy(other))
-    _physics(element, world.physics)
+        name = light_name(other)
+        if lights is None or name is None:
+            element.append(copy.deepcopy(other))
+        elif name in lights:  # a deleted light is left out
+            light = lights[name]
+            element.append(copy.deepcopy(other) if light == read_light(other) else _light(name, light))
+    _physics(element, world.physics if physics is None else physics)
     base = os.path.dirname(os.path.abspath(world.path))
     main_models = {id(model) for model in world.models + world.robots}
     for model in models:
@@ -127,6 +139,20 @@ def _state(world_name: str, poses: Mapping[str, Pose], link_states: Mapping[str,
                 parent = nested if nested is not None else ET.SubElement(parent, "model", name=scope)
             ET.SubElement(ET.SubElement(parent, "link", name=local), "pose").text = pose_text(pose)
     return state
+
+
+def _light(name: str, light: Light) -> ET.Element:
+    """A <light> with every value ``light`` has, so that reading it back gives ``light`` whatever the defaults."""
+    element = ET.Element("light", name=name, type=light.type)
+    ET.SubElement(element, "cast_shadows").text = "true" if light.cast_shadows else "false"
+    ET.SubElement(element, "pose").text = pose_text(light.pose)
+    ET.SubElement(element, "diffuse").text = " ".join(_number(value) for value in light.diffuse)
+    ET.SubElement(element, "specular").text = " ".join(_number(value) for value in light.specular)
+    attenuation = ET.SubElement(element, "attenuation")
+    for tag, value in zip(("range", "constant", "linear", "quadratic"), (light.range, *light.attenuation)):
+        ET.SubElement(attenuation, tag).text = _number(value)
+    ET.SubElement(element, "direction").text = " ".join(_number(value) for value in light.direction)
+    return element
 
 
 def _physics(world: ET.Element, physics: PhysicsConfig):
