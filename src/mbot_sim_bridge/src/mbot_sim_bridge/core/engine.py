@@ -18,7 +18,7 @@ from pybullet_utils.bullet_client import BulletClient
 from .errors import ModelError
 from .geometry import (IDENTITY, Pose, compose, cross_products, inverse, quaternion_products, rotate,
                        rotation_matrices, rotation_matrix)
-from .log import c_stdout_to, get_logger, warn_once
+from .log import c_stdout_to, get_logger, info_once, warn_once
 from .description.mesh import with_pybullet_readable_meshes
 from .description.robot_model import RobotModel
 from .description.world_description import PhysicsConfig
@@ -709,8 +709,8 @@ class Engine:
         """Friction of every Bullet link; ball casters (see RobotModel.caster_links) are those on joints not driven."""
         robot.driven_joints = tuple(driven_joints)
         casters = set(robot.model.caster_links(driven_joints))
-        if casters:
-            _logger.info(f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
+        if casters:  # said once: set_physics_properties sets the surfaces again
+            info_once(_logger, f"{robot.name}: ball-caster contact (frictionless) for {', '.join(sorted(casters))}")
         source = f"model '{robot.name}'"
         # The wheels that carry fdir1 get the wheel contact model; Gazebo's ODE too turns friction with them only.
         modelled = {link_name: wheel_axle for link_name, wheel_axle in robot.model.wheels.items()
