@@ -273,12 +273,16 @@ def view_3d(image, background):
 
 
 def colour_mask(view, colour):
-    """Pixels of ``colour`` under any lighting: the same channel proportions, not too dark."""
-    pixels = view.astype(float)
-    brightest = pixels.max(axis=2, keepdims=True)
+    """Pixels of ``colour`` under any lighting: the same channel proportions, not too dark.
+
+    The proportions are worked out for the pixels bright enough only: the dark background is most of a view, and
+    the tests look at a screenshot every half second."""
     reference = np.asarray(colour, dtype=float)
-    return (np.all(np.abs(pixels / np.maximum(brightest, 1.0) - reference / reference.max()) < 0.06, axis=2)
-            & (brightest[..., 0] > 0.35 * reference.max()))
+    mask = view.max(axis=2) > 0.35 * reference.max()
+    pixels = view[mask].astype(float)
+    brightest = pixels.max(axis=1, keepdims=True)
+    mask[mask] = np.all(np.abs(pixels / np.maximum(brightest, 1.0) - reference / reference.max()) < 0.06, axis=1)
+    return mask
 
 
 def colour_count(view, colour):
@@ -291,7 +295,7 @@ def scan_pixels_off_robot(view, robot_colour, scan_colour):
     The Odometry arrow, drawn on the robot in a similar red, stays within that circle.
     """
     robot = np.argwhere(colour_mask(view, robot_colour))
-    scan = np.argwhere(np.all(np.abs(view.astype(int) - scan_colour) <= 10, axis=2))
+    scan = np.argwhere(np.all(np.abs(view.astype(np.int16) - scan_colour) <= 10, axis=2))
     if not len(robot):
         return scan
     centre = robot.mean(axis=0)
