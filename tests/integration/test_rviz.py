@@ -218,7 +218,8 @@ def start_rviz(config, environment, log_path, master, timeout):
     master (or exited); the caller stops it."""
     config = at_test_frame_rate(config, os.path.dirname(log_path))
     with open(log_path, "w") as log:
-        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+        # Debian's rviz on the PATH, the binary rosrun runs, without rosrun's package look-ups (catkin_find runs).
+        rviz = subprocess.Popen(["rviz", "-d", config, "__name:=rviz"], env=environment,
                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), timeout,
