@@ -36,7 +36,7 @@ def spawned(ros_env):
 def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):
     screenshot = tmp_path / "pybullet_gui.png"
     with Xvfb(tmp_path / "xvfb.log", screen="{}x{}x24".format(*WINDOW_SIZE)) as server:
-        ros_env.update(DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1")
+        ros_env.update(server.environment({}))
         simulation = launch("mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=true")
         wait_until(lambda: window_resized(server.display), 90, f"the simulator's window (see {simulation.log_path})",
                    interval=0.25)

@@ -131,7 +131,7 @@ def test_rviz_shows_the_robot(config, scenes, screen, tmp_path):
 
     screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
     # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
-    environment = dict(ros_env, DISPLAY=screen.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+    environment = screen.environment(ros_env, HOME=str(tmp_path))
     for attempt in range(1, RVIZ_ATTEMPTS + 1):
         log_path = tmp_path / (f"rviz-{attempt}.log")
         rviz = start_rviz(config, environment, log_path, master, 30)

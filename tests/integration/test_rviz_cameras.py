@@ -71,7 +71,7 @@ def test_rviz_shows_the_camera_picture(case, ros_env, launch, screen, tmp_path):
 
     screenshot = tmp_path / ("rviz_" + config_name.replace(".rviz", ".png"))
     log_path = tmp_path / "rviz.log"
-    environment = dict(ros_env, DISPLAY=screen.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+    environment = screen.environment(ros_env, HOME=str(tmp_path))
     rviz = start_rviz(config, environment, log_path, master, 60)
     try:
         # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.

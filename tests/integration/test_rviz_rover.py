@@ -46,7 +46,7 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
     colour = base_link_colour(master.getParam("/robot_description"))
     shots = [tmp_path / "rviz_rover_at_rest.png", tmp_path / "rviz_rover_driven.png"]
     with Xvfb(tmp_path / "xvfb.log") as server:
-        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+        environment = server.environment(ros_env, HOME=str(tmp_path))
         log_path = tmp_path / "rviz.log"
         rviz = start_rviz(CONFIG, environment, log_path, master, 30)
         driver = None
