@@ -8,7 +8,6 @@ The checks look at the 3D view of a screenshot: the colour of the robot's base f
 the LaserScan display's flat colour from the config. MBOT_SCREENSHOT_DIR, if set, receives a copy of each
 screenshot.
 """
-import contextlib
 import glob
 import os
 import re
@@ -46,7 +45,7 @@ RVIZ_ATTEMPTS = 2
 # Python, and asked every 20 ms while a simulation starts they were a tenth of a test's CPU.
 MASTER_POLL = 0.25
 TEST_FRAME_RATE = 5  # frames per second; the shipped configs ask for 30 (see at_test_frame_rate)
-# Config -> (launch file and args, the robot_description it draws, topics to wait for); others: the play ground.
+# Config -> its scene (see Scenes); others: the play ground.
 SCENES = {"multi_mbot.rviz": (("multi_mbot.launch", "count:=2"), "/mbot_1/robot_description",
                               {"/mbot_1/odom", "/mbot_2/scan", "/tf", "/tf_static"})}
 PLAY_GROUND = (("mbot_play_ground.launch",), "/robot_description", {"/odom", "/scan", "/tf", "/tf_static"})
@@ -58,13 +57,14 @@ def test_the_shipped_configs_are_found():
 
 
 class Scenes:
-    """The simulations the configs are drawn against, each with a master of its own, started when a config first
-    asks for one and kept for the next config that draws the same scene (mbot.rviz and mbot_with_laser.rviz both
-    draw the play ground); one runs at a time."""
+    """The simulations the configs are drawn against, on one master: each started when a config first asks for it
+    and kept for the next config that draws the same scene (mbot.rviz and mbot_with_laser.rviz both draw the play
+    ground); one runs at a time. A scene: (launch file and args, the robot_description it draws, topics to wait
+    for)."""
 
-    def __init__(self, folder):
-        self.folder = folder
-        self.running = None  # (scene, ExitStack that stops it, (environment, master client, robot colour))
+    def __init__(self, folder, master):
+        self.folder, self.master = folder, master
+        self.running = None  # (scene, roslaunch process, (environment, master client, robot colour))
 
     def get(self, scene):
         if self.running is not None and self.running[0] != scene:
@@ -75,37 +75,37 @@ class Scenes:
 
     def stop(self):
         if self.running is not None:
-            stack = self.running[1]
+            simulation = self.running[1]
             self.running = None
-            stack.close()
+            stop_process_group(simulation)
 
     def _start(self, scene):
         launch_file, description, topics = scene
         folder = self.folder / launch_file[0].replace(".launch", "")
         folder.mkdir()
-        with contextlib.ExitStack() as stack:
-            master = stack.enter_context(PrivateMaster())
-            environment = dict(master.environment, ROS_LOG_DIR=str(folder), PYTHONUNBUFFERED="1")
-            log_path = folder / "roslaunch.log"
-            with open(log_path, "w") as log:
-                simulation = subprocess.Popen(["roslaunch", "mbot_gazebo", *launch_file, "gui:=false"],
-                                              env=environment, stdout=log, stderr=subprocess.STDOUT,
-                                              start_new_session=True)
-            stack.callback(stop_process_group, simulation)
+        environment = dict(self.master.environment, ROS_LOG_DIR=str(folder), PYTHONUNBUFFERED="1")
+        log_path = folder / "roslaunch.log"
+        with open(log_path, "w") as log:
+            simulation = subprocess.Popen(["roslaunch", "mbot_gazebo", *launch_file, "gui:=false"], env=environment,
+                                          stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
             client = rosgraph.Master("/test_rviz", master_uri=environment["ROS_MASTER_URI"])
-            wait_until(lambda: published(client) >= topics, 60,
+            wait_until(lambda: published(client) >= topics, 90,
                        f"the simulation's {', '.join(sorted(topics))} (see {log_path})", interval=MASTER_POLL)
-            reading = (environment, client, base_link_colour(client.getParam(description)))
-            return scene, stack.pop_all(), reading
+            return scene, simulation, (environment, client, base_link_colour(client.getParam(description)))
+        except BaseException:
+            stop_process_group(simulation)
+            raise
 
 
 @pytest.fixture(scope="module")
 def scenes(tmp_path_factory):
-    scenes = Scenes(tmp_path_factory.mktemp("scenes"))
-    try:
-        yield scenes
-    finally:
-        scenes.stop()
+    with PrivateMaster() as master:
+        scenes = Scenes(tmp_path_factory.mktemp("scenes"), master)
+        try:
+            yield scenes
+        finally:
+            scenes.stop()
 
 
 @pytest.fixture(scope="module")
