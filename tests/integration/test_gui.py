@@ -1,6 +1,7 @@
 """The simulator window: PyBullet's GUI opens on a (virtual) display and shows the robot in its Gazebo
 colours; without a display, or with headless:=true, the simulator runs without one and says so once."""
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -9,12 +10,22 @@ from ros_processes import call_service, service_up, wait_until
 from xvfb import Xvfb
 
 MIN_ROBOT_PIXELS = 200
+# The window's thread draws continuously in software OpenGL: at PyBullet's 1024x768 that was most of the test's CPU.
+# At this size the mbot covers about 900 pixels (about 400 at 320x240); the screen is the window's size.
+WINDOW_SIZE = (480, 360)
 
 
 def gazebo_blue_pixels(image) -> int:
     """Pixels of the base's Gazebo/Blue (pure blue, lit and shaded), which nothing else in the scene uses."""
     red, green, blue = (image[:, :, channel].astype(int) for channel in range(3))
     return int(np.count_nonzero((blue > 90) & (red < 40) & (green < 40)))
+
+
+def window_resized(display) -> bool:
+    """Whether PyBullet's window is open, and then it is given WINDOW_SIZE."""
+    command = ["xdotool", "search", "--name", "^Bullet Physics", "windowsize", "%@", *map(str, WINDOW_SIZE)]
+    return subprocess.run(command, env=dict(os.environ, DISPLAY=display), capture_output=True,
+                          timeout=10).returncode == 0
 
 
 def spawned(ros_env):
@@ -24,12 +35,18 @@ def spawned(ros_env):
 
 def test_window_shows_the_robot_in_gazebo_blue(ros_env, launch, tmp_path):
     screenshot = tmp_path / "pybullet_gui.png"
-    with Xvfb(tmp_path / "xvfb.log") as server:
-        ros_env.update(DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1")
+    with Xvfb(tmp_path / "xvfb.log", screen="{}x{}x24".format(*WINDOW_SIZE)) as server:
+        ros_env.update(server.environment({}))
         simulation = launch("mbot_gazebo", "view_mbot_gazebo_empty_world.launch", "gui:=true")
-        wait_until(lambda: spawned(ros_env), 90, f"the mbot to spawn (see {simulation.log_path})")
-        wait_until(lambda: gazebo_blue_pixels(server.screenshot(screenshot)) >= MIN_ROBOT_PIXELS, 60,
-                   f"the blue mbot in the window (screenshot {screenshot})")
+        wait_until(lambda: window_resized(server.display), 90, f"the simulator's window (see {simulation.log_path})",
+                   interval=0.25)
+        wait_until(lambda: spawned(ros_env), 90, f"the mbot to spawn (see {simulation.log_path})", interval=0.25)
+
+        def blue_robot():
+            pixels = gazebo_blue_pixels(server.screenshot(screenshot))
+            return pixels if pixels >= MIN_ROBOT_PIXELS else 0
+        pixels = wait_until(blue_robot, 60, f"the blue mbot in the window (screenshot {screenshot})", interval=0.25)
+        print(f"figure: the mbot on {pixels} Gazebo/Blue pixels of the {WINDOW_SIZE} window")
         if os.environ.get("MBOT_SCREENSHOT_DIR"):
             server.screenshot(os.path.join(os.environ["MBOT_SCREENSHOT_DIR"], "pybullet_gui.png"))
     # The simulator's start-up line ends with its mode.

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import rosgraph
 import yaml
-from mbot_sim_bridge.processes import stop_process_group
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 
 from ros_processes import TESTS, wait_until
 from xvfb import Xvfb
@@ -41,8 +41,11 @@ STEADY = 3.0
 # Each screenshot is an xwd, a PNG and its analysis: taken back to back they were a tenth of a test's CPU.
 SCREENSHOT_PERIOD = 0.5
 RVIZ_ATTEMPTS = 2
+# Seconds between the tests' questions to the master: each getSystemState is an XML-RPC call rosmaster answers in
+# Python, and asked every 20 ms while a simulation starts they were a tenth of a test's CPU.
+MASTER_POLL = 0.25
 TEST_FRAME_RATE = 5  # frames per second; the shipped configs ask for 30 (see at_test_frame_rate)
-# Config -> (launch file and args, the robot_description it draws, topics to wait for); others: the play ground.
+# Config -> its scene (see Scenes); others: the play ground.
 SCENES = {"multi_mbot.rviz": (("multi_mbot.launch", "count:=2"), "/mbot_1/robot_description",
                               {"/mbot_1/odom", "/mbot_2/scan", "/tf", "/tf_static"})}
 PLAY_GROUND = (("mbot_play_ground.launch",), "/robot_description", {"/odom", "/scan", "/tf", "/tf_static"})
@@ -53,19 +56,72 @@ def test_the_shipped_configs_are_found():
     assert {os.path.basename(path) for path in SHIPPED_CONFIGS} >= CAMERA_CONFIGS
 
 
+class Scenes:
+    """The simulations the configs are drawn against, on one master: each started when a config first asks for it
+    and kept for the next config that draws the same scene (mbot.rviz and mbot_with_laser.rviz both draw the play
+    ground); one runs at a time. A scene: (launch file and args, the robot_description it draws, topics to wait
+    for)."""
+
+    def __init__(self, folder, master):
+        self.folder, self.master = folder, master
+        self.running = None  # (scene, roslaunch process, (environment, master client, robot colour))
+
+    def get(self, scene):
+        if self.running is not None and self.running[0] != scene:
+            self.stop()
+        if self.running is None:
+            self.running = self._start(scene)
+        return self.running[2]
+
+    def stop(self):
+        if self.running is not None:
+            simulation = self.running[1]
+            self.running = None
+            stop_process_group(simulation)
+
+    def _start(self, scene):
+        launch_file, description, topics = scene
+        folder = self.folder / launch_file[0].replace(".launch", "")
+        folder.mkdir()
+        environment = dict(self.master.environment, ROS_LOG_DIR=str(folder), PYTHONUNBUFFERED="1")
+        log_path = folder / "roslaunch.log"
+        with open(log_path, "w") as log:
+            simulation = subprocess.Popen(["roslaunch", "mbot_gazebo", *launch_file, "gui:=false"], env=environment,
+                                          stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            client = rosgraph.Master("/test_rviz", master_uri=environment["ROS_MASTER_URI"])
+            wait_until(lambda: published(client) >= topics, 90,
+                       f"the simulation's {', '.join(sorted(topics))} (see {log_path})", interval=MASTER_POLL)
+            return scene, simulation, (environment, client, base_link_colour(client.getParam(description)))
+        except BaseException:
+            stop_process_group(simulation)
+            raise
+
+
+@pytest.fixture(scope="module")
+def scenes(tmp_path_factory):
+    with PrivateMaster() as master:
+        scenes = Scenes(tmp_path_factory.mktemp("scenes"), master)
+        try:
+            yield scenes
+        finally:
+            scenes.stop()
+
+
+@pytest.fixture(scope="module")
+def screen(tmp_path_factory):
+    """One private X server for the module's rviz runs, one after another."""
+    with Xvfb(tmp_path_factory.mktemp("xvfb") / "xvfb.log") as server:
+        yield server
+
+
 @pytest.mark.parametrize("config", CONFIGS, ids=os.path.basename)
-def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
+def test_rviz_shows_the_robot(config, scenes, screen, tmp_path):
     with open(config) as stream:
         displays = yaml.safe_load(stream)["Visualization Manager"]
     background = parse_colour(displays["Global Options"]["Background Color"])
     scan_colour = laser_scan_colour(displays["Displays"])
-
-    launch_file, description, topics = SCENES.get(os.path.basename(config), PLAY_GROUND)
-    simulation = launch("mbot_gazebo", *launch_file, "gui:=false")
-    master = rosgraph.Master("/test_rviz", master_uri=ros_env["ROS_MASTER_URI"])
-    wait_until(lambda: published(master) >= topics, 60,
-               f"the simulation's {', '.join(sorted(topics))} (see {simulation.log_path})")
-    robot_colour = base_link_colour(master.getParam(description))
+    ros_env, master, robot_colour = scenes.get(SCENES.get(os.path.basename(config), PLAY_GROUND))
 
     def drawn(image):
         view = view_3d(image, background)
@@ -74,24 +130,23 @@ def test_rviz_shows_the_robot(config, ros_env, launch, tmp_path):
                      >= MIN_SCAN_PIXELS))
 
     screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
-    with Xvfb(tmp_path / "xvfb.log") as server:
-        # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
-        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
-        for attempt in range(1, RVIZ_ATTEMPTS + 1):
-            log_path = tmp_path / (f"rviz-{attempt}.log")
-            rviz = start_rviz(config, environment, log_path, master, 30)
-            try:
-                image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image),
-                              DRAW_TIMEOUT, STEADY)
-                crashed = rviz.poll() is not None
-            finally:
-                stop_process_group(rviz)
-            if not crashed:
-                break
-            # rviz 1.14 sometimes aborts in OGRE's start-up under software OpenGL (std::bad_alloc); that is
-            # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
-            print(f"rviz exited with {rviz.returncode} on start {attempt}:\n{log_path.read_text()}")
-        assert not crashed, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
+    # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
+    environment = screen.environment(ros_env, HOME=str(tmp_path))
+    for attempt in range(1, RVIZ_ATTEMPTS + 1):
+        log_path = tmp_path / (f"rviz-{attempt}.log")
+        rviz = start_rviz(config, environment, log_path, master, 30)
+        try:
+            image = watch(screen, screenshot, lambda image: rviz.poll() is not None or drawn(image),
+                          DRAW_TIMEOUT, STEADY)
+            crashed = rviz.poll() is not None
+        finally:
+            stop_process_group(rviz)
+        if not crashed:
+            break
+        # rviz 1.14 sometimes aborts in OGRE's start-up under software OpenGL (std::bad_alloc); that is
+        # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
+        print(f"rviz exited with {rviz.returncode} on start {attempt}:\n{log_path.read_text()}")
+    assert not crashed, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
     keep_screenshot(screenshot)
 
     where = f"(screenshot {screenshot}, rviz output {log_path})"
@@ -163,11 +218,12 @@ def start_rviz(config, environment, log_path, master, timeout):
     master (or exited); the caller stops it."""
     config = at_test_frame_rate(config, os.path.dirname(log_path))
     with open(log_path, "w") as log:
-        rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", config, "__name:=rviz"], env=environment,
+        # Debian's rviz on the PATH, the binary rosrun runs, without rosrun's package look-ups (catkin_find runs).
+        rviz = subprocess.Popen(["rviz", "-d", config, "__name:=rviz"], env=environment,
                                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         wait_until(lambda: rviz.poll() is not None or node_registered(master, "/rviz"), timeout,
-                   "rviz to register with the master")
+                   "rviz to register with the master", interval=MASTER_POLL)
     except BaseException:
         stop_process_group(rviz)
         raise
@@ -218,12 +274,16 @@ def view_3d(image, background):
 
 
 def colour_mask(view, colour):
-    """Pixels of ``colour`` under any lighting: the same channel proportions, not too dark."""
-    pixels = view.astype(float)
-    brightest = pixels.max(axis=2, keepdims=True)
+    """Pixels of ``colour`` under any lighting: the same channel proportions, not too dark.
+
+    The proportions are worked out for the pixels bright enough only: the dark background is most of a view, and
+    the tests look at a screenshot every half second."""
     reference = np.asarray(colour, dtype=float)
-    return (np.all(np.abs(pixels / np.maximum(brightest, 1.0) - reference / reference.max()) < 0.06, axis=2)
-            & (brightest[..., 0] > 0.35 * reference.max()))
+    mask = view.max(axis=2) > 0.35 * reference.max()
+    pixels = view[mask].astype(float)
+    brightest = pixels.max(axis=1, keepdims=True)
+    mask[mask] = np.all(np.abs(pixels / np.maximum(brightest, 1.0) - reference / reference.max()) < 0.06, axis=1)
+    return mask
 
 
 def colour_count(view, colour):
@@ -236,7 +296,7 @@ def scan_pixels_off_robot(view, robot_colour, scan_colour):
     The Odometry arrow, drawn on the robot in a similar red, stays within that circle.
     """
     robot = np.argwhere(colour_mask(view, robot_colour))
-    scan = np.argwhere(np.all(np.abs(view.astype(int) - scan_colour) <= 10, axis=2))
+    scan = np.argwhere(np.all(np.abs(view.astype(np.int16) - scan_colour) <= 10, axis=2))
     if not len(robot):
         return scan
     centre = robot.mean(axis=0)

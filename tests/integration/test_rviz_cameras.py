@@ -11,14 +11,12 @@ import os
 
 import numpy as np
 import pytest
-import rosgraph
 import yaml
 from mbot_sim_bridge.processes import stop_process_group
 
-from ros_processes import TESTS, wait_until
-from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, base_link_colour, colour_count, keep_screenshot,
-                       parse_colour, published, start_rviz, view_3d, watch)
-from xvfb import Xvfb
+from ros_processes import TESTS
+from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, colour_count, keep_screenshot, parse_colour, scenes,
+                       screen, start_rviz, view_3d, watch)  # noqa: F401 (scenes and screen: fixtures)
 
 CONFIG_DIR = os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config")
 SKY = np.array((178, 178, 178))
@@ -51,18 +49,14 @@ def test_these_are_the_configs_test_rviz_leaves_out():
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
+def test_rviz_shows_the_camera_picture(case, scenes, screen, tmp_path):
     launch_file, config_name, topics = CASES[case]
     config = os.path.join(CONFIG_DIR, config_name)
     with open(config) as stream:
         displays = yaml.safe_load(stream)["Visualization Manager"]
     background = parse_colour(displays["Global Options"]["Background Color"])
 
-    simulation = launch("mbot_gazebo", launch_file, "gui:=false")
-    master = rosgraph.Master("/test_rviz_cameras", master_uri=ros_env["ROS_MASTER_URI"])
-    wait_until(lambda: published(master) >= topics | {"/odom", "/tf"}, 90,
-               f"{', '.join(sorted(topics))} and /odom, /tf (see {simulation.log_path})")
-    robot_colour = base_link_colour(master.getParam("/robot_description"))
+    ros_env, master, robot_colour = scenes.get(((launch_file,), "/robot_description", topics | {"/odom", "/tf"}))
 
     def drawn(image):
         view = view_3d(image, background)
@@ -72,14 +66,13 @@ def test_rviz_shows_the_camera_picture(case, ros_env, launch, tmp_path):
 
     screenshot = tmp_path / ("rviz_" + config_name.replace(".rviz", ".png"))
     log_path = tmp_path / "rviz.log"
-    with Xvfb(tmp_path / "xvfb.log") as server:
-        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
-        rviz = start_rviz(config, environment, log_path, master, 60)
-        try:
-            # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
-            image = watch(server, screenshot, lambda image: rviz.poll() is not None or drawn(image), 120, 2.0)
-        finally:
-            stop_process_group(rviz)
+    environment = screen.environment(ros_env, HOME=str(tmp_path))
+    rviz = start_rviz(config, environment, log_path, master, 60)
+    try:
+        # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
+        image = watch(screen, screenshot, lambda image: rviz.poll() is not None or drawn(image), 120, 2.0)
+    finally:
+        stop_process_group(rviz)
     keep_screenshot(screenshot)
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     view = view_3d(image, background)

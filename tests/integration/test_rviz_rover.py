@@ -13,8 +13,8 @@ import yaml
 from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
-from test_rviz import (DRAW_TIMEOUT, MIN_ROBOT_PIXELS, assert_no_tf_errors, base_link_colour, colour_mask,
-                       parse_colour, published, start_rviz, view_3d, watch)
+from test_rviz import (DRAW_TIMEOUT, MASTER_POLL, MIN_ROBOT_PIXELS, assert_no_tf_errors, base_link_colour,
+                       colour_mask, parse_colour, published, start_rviz, view_3d, watch)
 from xvfb import Xvfb
 
 pytestmark = pytest.mark.long
@@ -42,11 +42,11 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
     simulation = launch("rover_gazebo", "rover_empty_world.launch", "gui:=false", "lidar_3d_enabled:=false")
     master = rosgraph.Master("/test_rviz_rover", master_uri=ros_env["ROS_MASTER_URI"])
     wait_until(lambda: published(master) >= TOPICS, 60, f"the rover's {', '.join(sorted(TOPICS))} "
-               f"(see {simulation.log_path})")
+               f"(see {simulation.log_path})", interval=MASTER_POLL)
     colour = base_link_colour(master.getParam("/robot_description"))
     shots = [tmp_path / "rviz_rover_at_rest.png", tmp_path / "rviz_rover_driven.png"]
     with Xvfb(tmp_path / "xvfb.log") as server:
-        environment = dict(ros_env, DISPLAY=server.display, LIBGL_ALWAYS_SOFTWARE="1", HOME=str(tmp_path))
+        environment = server.environment(ros_env, HOME=str(tmp_path))
         log_path = tmp_path / "rviz.log"
         rviz = start_rviz(CONFIG, environment, log_path, master, 30)
         driver = None

@@ -47,6 +47,11 @@ class Xvfb:
     def __exit__(self, *exc_info):
         self._stop()
 
+    def environment(self, base, **more) -> dict:
+        """``base`` with DISPLAY on this server and Mesa's software OpenGL on one thread: llvmpipe's rasteriser
+        threads cost more CPU to keep in step than they save on these tests' small or infrequent frames."""
+        return dict(base, DISPLAY=self.display, LIBGL_ALWAYS_SOFTWARE="1", LP_NUM_THREADS="1", **more)
+
     def screenshot(self, png_path, attempts=3) -> np.ndarray:
         """Save the whole screen as a PNG; returns it as an (height, width, 3) uint8 RGB array.
 
