@@ -9,7 +9,7 @@ import pytest
 from mbot_sim_bridge.processes import stop_process_group
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 
-from ros_processes import TESTS, call_service, run, service_up, wait_until
+from ros_processes import TESTS, call_service, rosrun, run, service_up, wait_until
 
 pytestmark = pytest.mark.long
 
@@ -26,7 +26,7 @@ def start_bridge(ros_env, launch, *arguments):
 
 
 def mbot_world(ros_env, *arguments):
-    return run(["rosrun", "mbot_gazebo", "mbot_world", *arguments], ros_env)
+    return run(rosrun("mbot_gazebo", "mbot_world", *arguments), ros_env)
 
 
 def ok(result):
