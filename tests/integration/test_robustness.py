@@ -4,15 +4,17 @@ each through the real ROS path (spawn_model, rosservice) against a running bridg
 After every bad input the bridge must still serve the good mbot: /clock goes on, its /odom arrives finite,
 and it still takes requests.
 """
+import ast
 import math
 import os
 import subprocess
+import sys
+import textwrap
 import threading
 import time
 from xml.etree import ElementTree
 
 import pytest
-import yaml
 
 from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
 from ros_processes import call_service, rosrun, run, wait_until
@@ -77,10 +79,69 @@ def call(ros_env, service, request="{}"):
     return call_service(ros_env, "/gazebo/" + service, request, CALL_TIMEOUT)
 
 
-def echo(ros_env, topic, timeout=CALL_TIMEOUT):
-    result = run(["rostopic", "echo", "-n", "1", "--noarr", topic], ros_env, timeout=timeout)
-    assert result.returncode == 0, f"no message on {topic}:\n{result.stderr}"
-    return yaml.safe_load(result.stdout.split("\n---")[0])
+# The good mbot's client for the whole module, in one process: a rostopic process per check cost 0.4 CPU seconds.
+# Each "odom" line on its input is answered with the position of the next /good/odom message (subscribed for that
+# message only, as rostopic echo -n 1 is); "drive" publishes the command below at 10 Hz until "stop".
+GOOD_MBOT_CLIENT = textwrap.dedent(f"""
+    import sys
+    import threading
+
+    import rospy
+    import rospy.impl.simtime
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+
+    # Its waits are in wall time: no /clock subscription (100 messages a second, all module long).
+    rospy.impl.simtime.init_simtime = lambda: True
+    rospy.init_node("good_mbot_client", disable_signals=True)
+    command = rospy.Publisher("/good/cmd_vel", Twist, queue_size=1)
+    driving = threading.Event()
+
+    def drive():
+        twist = Twist()
+        twist.linear.x, twist.angular.z = 0.2, 0.5
+        while not rospy.is_shutdown():
+            driving.wait()
+            command.publish(twist)
+            rospy.rostime.wallsleep(0.1)
+
+    threading.Thread(target=drive, daemon=True).start()
+    for line in sys.stdin:
+        if line == "drive\n":
+            driving.set()
+        elif line == "stop\n":
+            driving.clear()
+        else:
+            try:
+                position = rospy.wait_for_message("/good/odom", Odometry, timeout={CALL_TIMEOUT}).pose.pose.position
+                print(repr((position.x, position.y, position.z)), flush=True)
+            except rospy.ROSException as error:
+                print(repr(str(error)), flush=True)
+""")
+
+
+class GoodMbotClient:
+    def __init__(self, ros_env, log_path):
+        with open(log_path, "w") as log:
+            self.process = subprocess.Popen([sys.executable, "-c", GOOD_MBOT_CLIENT], env=ros_env, text=True,
+                                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log,
+                                            start_new_session=True)
+        self.log_path = log_path
+
+    def send(self, line):
+        self.process.stdin.write(line + "\n")
+        self.process.stdin.flush()
+
+    def odometry_position(self):
+        """The position in the next /good/odom message (a tuple), or why none came (a text)."""
+        self.send("odom")
+        answer = self.process.stdout.readline()
+        assert answer, "the good mbot's client stopped:\n" + open(self.log_path).read()
+        return ast.literal_eval(answer)
+
+    def close(self):
+        self.process.stdin.close()
+        stop_process_group(self.process)
 
 
 def model_pose(ros_env, name):
@@ -110,12 +171,14 @@ def shared(tmp_path_factory, mbot_urdf):
             process = subprocess.Popen(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false"],
                                        env=environment, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
         process.log_path = log_path
+        process.good_mbot = GoodMbotClient(environment, directory / "good_mbot_client.log")
         try:
             result = spawn(environment, directory, "good", without_namespace(mbot_urdf), "-robot_namespace", "/good",
                            timeout=CALL_TIMEOUT)
             assert result.returncode == 0, result.stderr + open(log_path).read()
             yield environment, process
         finally:
+            process.good_mbot.close()
             stop_process_group(process)
 
 
@@ -134,19 +197,17 @@ def assert_still_serving(ros_env, bridge, drive=False):
     ``drive``, still drives: a few seconds more, spent where a request could have wedged the robot)."""
     assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
     first = sim_time(ros_env)
-    odometry = echo(ros_env, "/good/odom")
-    position = odometry["pose"]["pose"]["position"]
-    assert all(math.isfinite(float(position[axis])) for axis in "xyz"), odometry
+    position = bridge.good_mbot.odometry_position()
+    assert isinstance(position, tuple) and all(math.isfinite(value) for value in position), \
+        f"no finite message on /good/odom: {position}"
     if drive:
         before = model_pose(ros_env, "good")
         # A reset stops the drive (as Gazebo's Reset does): command it again each time.
-        command = subprocess.Popen(["rostopic", "pub", "-r", "10", "/good/cmd_vel", "geometry_msgs/Twist",
-                                    "{linear: {x: 0.2}, angular: {z: 0.5}}"], env=ros_env,
-                                   stdout=subprocess.DEVNULL, start_new_session=True)
+        bridge.good_mbot.send("drive")
         try:
             wait_until(lambda: math.dist(model_pose(ros_env, "good"), before) > 1e-3, 30, "the good mbot to move")
         finally:
-            stop_process_group(command)
+            bridge.good_mbot.send("stop")
     wait_until(lambda: sim_time(ros_env) > first, 10, "the clock to advance")
     assert bridge.poll() is None, "the bridge stopped:\n" + open(bridge.log_path).read()
 

@@ -1,6 +1,5 @@
 """The tutorial's first way to build an environment: insert models by name, arrange them, "Save world as", and
 load the saved world again (./mbot insert, move, delete, save-world; /gazebo/save_world)."""
-import json
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -35,8 +34,14 @@ def ok(result):
 
 
 def model_poses(ros_env):
-    output = ok(run(["python3", os.path.join(TESTS, "nodes", "model_poses.py")], ros_env))
-    return {name: (tuple(values[:3]), tuple(values[3:])) for name, values in json.loads(output).items()}
+    """Every model's world pose, {name: ((x, y, z), (qx, qy, qz, qw))}, read through /gazebo/get_model_state (which
+    answers while paused, when /gazebo/model_states is not published)."""
+    poses = {}
+    for name in call_service(ros_env, "/gazebo/get_world_properties")["model_names"]:
+        pose = call_service(ros_env, "/gazebo/get_model_state", f"{{model_name: '{name}'}}")["pose"]
+        poses[name] = (tuple(pose["position"][axis] for axis in "xyz"),
+                       tuple(pose["orientation"][axis] for axis in "xyzw"))
+    return poses
 
 
 def paused(ros_env):
