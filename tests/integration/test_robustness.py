@@ -107,9 +107,9 @@ GOOD_MBOT_CLIENT = textwrap.dedent(f"""
 
     threading.Thread(target=drive, daemon=True).start()
     for line in sys.stdin:
-        if line == "drive\n":
+        if line.strip() == "drive":
             driving.set()
-        elif line == "stop\n":
+        elif line.strip() == "stop":
             driving.clear()
         else:
             try:
