@@ -1,7 +1,10 @@
 """Bad input gets one clear line naming what is wrong, and no traceback."""
-import pytest
+import subprocess
 
-from ros_processes import run
+import pytest
+from mbot_sim_bridge.processes import PrivateMaster, stop_process_group
+
+from ros_processes import call_service, rosrun, run
 
 pytestmark = pytest.mark.long
 
@@ -20,32 +23,48 @@ def one_error_line(output, *expected):
 
 
 def spawn(ros_env, *arguments):
-    return run(["rosrun", "mbot_sim_bridge", "spawn_model", "-urdf", "-model", "probe", *arguments], ros_env)
+    return run(rosrun("mbot_sim_bridge", "spawn_model", "-urdf", "-model", "probe", *arguments), ros_env)
 
 
-def test_spawn_without_robot_description(ros_env):
-    result = spawn(ros_env, "-param", "robot_description")
+@pytest.fixture(scope="module")
+def simulator(tmp_path_factory):
+    """(environment, bridge): one simulator on a master of its own for the module's spawns, which leave it as
+    they found it (a launch per test cost two CPU seconds each)."""
+    directory = tmp_path_factory.mktemp("simulator")
+    with PrivateMaster() as master:
+        environment = dict(master.environment, ROS_LOG_DIR=str(directory), PYTHONUNBUFFERED="1")
+        with open(directory / "roslaunch.log", "w") as log:
+            bridge = subprocess.Popen(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false"],
+                                      env=environment, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            yield environment, bridge
+        finally:
+            stop_process_group(bridge)
+
+
+@pytest.fixture
+def sim_env(simulator):
+    return simulator[0]
+
+
+def test_spawn_without_robot_description(sim_env):
+    result = spawn(sim_env, "-param", "robot_description")
     assert result.returncode == 1
     one_error_line(result.stderr, "spawn_model:", "parameter /robot_description is not set")
 
 
-def test_spawn_from_a_file_that_is_not_xml(ros_env, tmp_path):
+def test_spawn_from_a_file_that_is_not_xml(sim_env, tmp_path):
     broken = tmp_path / "broken.urdf"
     broken.write_text("<robot name='x'><link name='a'>")
-    result = spawn(ros_env, "-file", str(broken))
+    result = spawn(sim_env, "-file", str(broken))
     assert result.returncode == 1
     one_error_line(result.stderr, "spawn_model:", str(broken), "is not valid XML")
 
 
-def test_spawn_from_a_missing_file(ros_env):
-    result = spawn(ros_env, "-file", "/nonexistent/robot.urdf")
+def test_spawn_from_a_missing_file(sim_env):
+    result = spawn(sim_env, "-file", "/nonexistent/robot.urdf")
     assert result.returncode == 1
     one_error_line(result.stderr, "cannot read model file /nonexistent/robot.urdf")
-
-
-@pytest.fixture
-def bridge(launch):
-    return launch("mbot_sim_bridge", "empty_world.launch", "gui:=false")
 
 
 @pytest.mark.parametrize("xml, expected", [
@@ -54,16 +73,19 @@ def bridge(launch):
      "</robot>", "joint 'j': child link 'b' is not defined"),
     (BAD_DRIVE, "<leftJoint> names joint 'left_wheel_joint', which the robot does not have"),
 ])
-def test_spawn_refused_by_the_simulator_names_the_problem(ros_env, bridge, tmp_path, xml, expected):
+def test_spawn_refused_by_the_simulator_names_the_problem(simulator, tmp_path, xml, expected):
+    environment, bridge = simulator
     model = tmp_path / "model.urdf"
     model.write_text(xml)
-    result = spawn(ros_env, "-file", str(model))
+    result = spawn(environment, "-file", str(model))
     assert result.returncode == 1, result.stderr
     one_error_line(result.stderr, "spawn_model: spawning 'probe' failed:", expected)
-    # The simulator carries on: a good model spawns afterwards.
+    # The simulator carries on: a good model spawns afterwards (and is deleted: the next test spawns 'probe' too).
     good = tmp_path / "good.urdf"
     good.write_text("<robot name='ok'><link name='a'/></robot>")
-    assert spawn(ros_env, "-file", str(good)).returncode == 0
+    assert spawn(environment, "-file", str(good)).returncode == 0
+    assert call_service(environment, "/gazebo/delete_model", "{model_name: probe}")["success"]
+    assert bridge.poll() is None
 
 
 def test_bridge_with_a_missing_world_exits_with_one_line(ros_env):

@@ -8,7 +8,7 @@ import sys
 import pytest
 from mbot_sim_bridge.processes import stop_process_group
 
-from ros_processes import TESTS, run, wait_until
+from ros_processes import TESTS, rosrun, run, wait_until
 
 CHECK_LOOP = os.path.join(TESTS, "integration", "publisher_check_loop.py")
 URDF = """<robot name="mbot"><link name="base_link"/>
@@ -43,8 +43,8 @@ SENDS = {"true": "zero positions for left_wheel_joint, right_wheel_joint, back_c
 def test_second_joint_states_publisher_is_reported_once(ros_env, processes, default_positions):
     assert run(["rosparam", "set", "robot_description", URDF], ros_env).returncode == 0
     loop_log = processes("check_loop", [sys.executable, CHECK_LOOP])
-    processes("joint_state_publisher", ["rosrun", "joint_state_publisher", "joint_state_publisher",
-                                        "_publish_default_positions:=" + default_positions])
+    processes("joint_state_publisher", rosrun("joint_state_publisher", "joint_state_publisher",
+                                             "_publish_default_positions:=" + default_positions))
     wait_until(lambda: "second publisher" in loop_log.read_text(), 60, "the check's warning")
     # Three more checks go by without a second warning.
     wait_until(lambda: _checks_after_warning(loop_log.read_text()) >= 3, 60, "three more checks")

@@ -1,6 +1,5 @@
 """The tutorial's first way to build an environment: insert models by name, arrange them, "Save world as", and
 load the saved world again (./mbot insert, move, delete, save-world; /gazebo/save_world)."""
-import json
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -9,7 +8,7 @@ import pytest
 from mbot_sim_bridge.processes import stop_process_group
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 
-from ros_processes import TESTS, call_service, run, service_up, wait_until
+from ros_processes import TESTS, call_service, rosrun, run, service_up, wait_until
 
 pytestmark = pytest.mark.long
 
@@ -26,7 +25,7 @@ def start_bridge(ros_env, launch, *arguments):
 
 
 def mbot_world(ros_env, *arguments):
-    return run(["rosrun", "mbot_gazebo", "mbot_world", *arguments], ros_env)
+    return run(rosrun("mbot_gazebo", "mbot_world", *arguments), ros_env)
 
 
 def ok(result):
@@ -35,8 +34,14 @@ def ok(result):
 
 
 def model_poses(ros_env):
-    output = ok(run(["python3", os.path.join(TESTS, "nodes", "model_poses.py")], ros_env))
-    return {name: (tuple(values[:3]), tuple(values[3:])) for name, values in json.loads(output).items()}
+    """Every model's world pose, {name: ((x, y, z), (qx, qy, qz, qw))}, read through /gazebo/get_model_state (which
+    answers while paused, when /gazebo/model_states is not published)."""
+    poses = {}
+    for name in call_service(ros_env, "/gazebo/get_world_properties")["model_names"]:
+        pose = call_service(ros_env, "/gazebo/get_model_state", f"{{model_name: '{name}'}}")["pose"]
+        poses[name] = (tuple(pose["position"][axis] for axis in "xyz"),
+                       tuple(pose["orientation"][axis] for axis in "xyzw"))
+    return poses
 
 
 def paused(ros_env):
@@ -90,6 +95,8 @@ def test_insert_move_save_and_relaunch_finds_every_model_where_it_was(ros_env, l
 
     relaunch(ros_env, launch, bridge, saved)
     assert_same_poses(model_poses(ros_env), before)
+    # The relaunched simulator, started paused, serves the bad-input checks (a start of their own cost 2 CPU s).
+    assert_bad_input_one_line_each_and_paused_stays_paused(ros_env, tmp_path / "bad_input")
 
 
 def test_play_ground_saved_and_reloaded_keeps_every_pose_robot_left_out(ros_env, launch, tmp_path):
@@ -111,8 +118,11 @@ def test_play_ground_saved_and_reloaded_keeps_every_pose_robot_left_out(ros_env,
     assert_same_poses(model_poses(ros_env), {name: pose for name, pose in before.items() if name != "mbot"})
 
 
-def test_bad_input_one_line_each_and_paused_stays_paused(ros_env, launch, tmp_path):
-    start_bridge(ros_env, launch, "paused:=true")
+def assert_bad_input_one_line_each_and_paused_stays_paused(ros_env, tmp_path):
+    """On a simulator started paused, with no model named unit_sphere: bad input gets one line each, and nothing
+    unpauses it."""
+    tmp_path.mkdir()
+    assert paused(ros_env)
     unknown = mbot_world(ros_env, "insert", "cafe_tabel")
     assert unknown.returncode == 1
     (line,) = unknown.stderr.strip().splitlines()
@@ -120,7 +130,7 @@ def test_bad_input_one_line_each_and_paused_stays_paused(ros_env, launch, tmp_pa
 
     assert "as 'unit_sphere'" in ok(mbot_world(ros_env, "insert", "unit_sphere", "-z", "2"))
     assert paused(ros_env)
-    ode = call_service(ros_env, "/gazebo/get_physics_properties")["ode_config"]  # the world's, SDF's defaults
+    ode = call_service(ros_env, "/gazebo/get_physics_properties")["ode_config"]  # SDF's defaults, as saved
     assert (ode["erp"], ode["contact_max_correcting_vel"], ode["contact_surface_layer"]) == (0.2, 100.0, 0.001)
     assert model_poses(ros_env)["unit_sphere"][0] == pytest.approx((0.0, 0.0, 2.0), abs=1e-6)  # no fall: paused
 
