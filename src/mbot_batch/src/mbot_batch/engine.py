@@ -97,13 +97,15 @@ def _collect_logs(folder: str) -> dict:
 
 
 def result_record(run: Run, raw: dict, spec: Spec, attempt: int, logs: dict) -> dict:
-    """The run's result.json: the verdict, its metrics, timing, where it ran and the tail of its main log."""
+    """The run's result.json: the verdict, its metrics, timing, where it ran, the CPU seconds of its processes and
+    the tail of its main log."""
     main_log = next((logs[name] for name in ("scenario.log", "rostest.log") if logs.get(name, "").strip()), "")
     tail = log_tail(main_log or logs.get("launch.log", "") or logs.get("run_process.log", ""))
     metrics = raw.get("metrics") or {}
     return {"run_id": run.run_id, "scenario": run.scenario, **verdict(raw, spec.scenarios[run.scenario].checks),
             "metrics": metrics, "attempts": attempt, "wall_seconds": raw.get("wall_seconds", 0.0),
-            "sim_seconds": metrics.get("sim_time", ""), "worker": raw.get("worker", ""), "log_tail": tail}
+            "sim_seconds": metrics.get("sim_time", ""), "worker": raw.get("worker", ""),
+            "cpu_seconds": raw.get("cpu_seconds", {}), "log_tail": tail}
 
 
 def connect(address, workers):
