@@ -82,10 +82,11 @@ def stop_group(process):
 
 @pytest.fixture(scope="module")
 def embedded(tmp_path_factory):
-    """The 4 runs on the embedded default, interrupted twice on the way; what each interruption left."""
+    """The 4 runs on the embedded default, interrupted twice on the way (one worker until then: each worker
+    process costs its start-up again); what each interruption left."""
     out = str(tmp_path_factory.mktemp("embedded") / "out")
     seen = {}
-    driver = start_batch(out, "--workers", "2")
+    driver = start_batch(out, "--workers", "1")
     try:
         wait_until(lambda: len(finished(out)) >= 2, BATCH_TIMEOUT, "two finished runs")
         driver.send_signal(signal.SIGKILL)  # the driver alone, as the kernel's OOM killer would
@@ -93,7 +94,7 @@ def embedded(tmp_path_factory):
         assert_no_run_processes(out, timeout=10.0)  # each run process sees its worker die and kills its run
         seen["after kill"] = result_files(out)
 
-        driver = start_batch(out, "--workers", "2")
+        driver = start_batch(out, "--workers", "1")
         wait_until(lambda: processes_with_token(batch_token(out)), 60, "a resumed run to be running",
                    interval=SCAN_INTERVAL)
         interrupted = time.monotonic()
@@ -103,7 +104,7 @@ def embedded(tmp_path_factory):
         seen["left after ctrl-c"] = processes_with_token(batch_token(out))
         seen["after ctrl-c"] = result_files(out)
 
-        driver = start_batch(out, "--workers", "2")
+        driver = start_batch(out)  # the embedded default: a worker per core
         driver.wait(timeout=BATCH_TIMEOUT)
         seen["exit"] = driver.returncode
     finally:
