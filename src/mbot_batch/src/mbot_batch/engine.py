@@ -35,7 +35,7 @@ LOG_CAP_BYTES = 200_000
 CLOSE_TIMEOUT_SECONDS = 3
 # Dask's own upkeep, slowed for tasks that are one long subprocess each: the worker's statistical profiler
 # (every 10 ms), the memory and system monitors (100 ms, 500 ms) and the event-loop tick (20 ms) kept an idle
-# local cluster of two workers at 0.077 cores, about 4 % of the example's CPU; with these, 0.010.
+# local cluster of two workers at 0.077 cores, about 4 % of the example's CPU; with these, 0.011.
 QUIET_UPKEEP = {"distributed.worker.profile.enabled": False,
                 "distributed.worker.memory.monitor-interval": "1s",
                 "distributed.admin.system-monitor.interval": "2s",

@@ -76,7 +76,7 @@ def _process_name(pid: int) -> str:
 
 def cpu_seconds(prefix: str, exclude=()) -> dict:
     """User and system CPU seconds of each live process with a token starting with ``prefix``, with the children
-    it has waited for (roslaunch's include xacro and spawn_model), by process name (summed over equal names)."""
+    it has waited for (roslaunch's: its xacro and spawn_model), by process name (summed over equal names)."""
     ticks = os.sysconf("SC_CLK_TCK")
     seconds = {}
     for pid in processes_with_token(prefix, exclude):
@@ -138,7 +138,7 @@ class RunProcesses:
                 self.set_parameters()
                 main_log, main, companions = self.start_run(launch or (self.run.launch_path and self.start_launch()))
                 ended = self.wait(main, companions, deadline)
-                raw["cpu_seconds"] = self.cpu_seconds(token, main_log)
+                raw["cpu_seconds"] = self.cpu_by_process(token, main_log)
             finally:
                 # The metrics are out: the run's processes are killed at once rather than stopped in turn, which
                 # took seconds per run under load. Its master too, then reaped by PrivateMaster.
@@ -156,7 +156,7 @@ class RunProcesses:
         return raw
 
     @staticmethod
-    def cpu_seconds(token: str, main_log: str) -> dict:
+    def cpu_by_process(token: str, main_log: str) -> dict:
         """Where the run's CPU went, by process: this process, the main one (waited for, so in this one's
         children's times) and every other process of the run, still running."""
         own = os.times()
