@@ -9,7 +9,7 @@ import math
 import numpy
 import rospy
 from mbot_batch import scenario
-from mbot_gazebo.demo import Recorder, Tour
+from mbot_gazebo.tour import Recorder, Tour
 from mbot_sim_bridge.lockstep import LockstepClient
 from sensor_msgs.msg import LaserScan
 

@@ -60,6 +60,37 @@ def kill_token(prefix: str, exclude=(), rounds: int = 50) -> int:
     return len(killed)
 
 
+def _process_name(pid: int) -> str:
+    """A ROS node's name (``__name:=``), a Python script's or module's name, or the program's."""
+    with open(f"/proc/{pid}/cmdline", "rb") as stream:
+        argv = [part.decode(errors="replace") for part in stream.read().split(b"\0") if part]
+    for part in argv:
+        if part.startswith("__name:="):
+            return part.split("=", 1)[1]
+    program = os.path.basename(argv[0]) if argv else str(pid)
+    if program.startswith("python") and len(argv) > 1:
+        script = next((part for part in argv[1:] if not part.startswith("-")), program)
+        return argv[argv.index("-m") + 1] if "-m" in argv else os.path.basename(script)
+    return program
+
+
+def cpu_seconds(prefix: str, exclude=()) -> dict:
+    """User and system CPU seconds of each live process with a token starting with ``prefix``, with the children
+    it has waited for (roslaunch's: its xacro and spawn_model), by process name (summed over equal names)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    seconds = {}
+    for pid in processes_with_token(prefix, exclude):
+        try:
+            with open(f"/proc/{pid}/stat") as stream:
+                fields = stream.read().rsplit(")", 1)[1].split()
+            name = _process_name(pid)
+        except OSError:
+            continue  # ended meanwhile
+        used = sum(int(field) for field in fields[11:15]) / ticks  # utime, stime, cutime, cstime
+        seconds[name] = seconds.get(name, 0.0) + used
+    return seconds
+
+
 def _alive(pid: int) -> bool:
     try:
         with open(f"/proc/{pid}/stat") as stream:
@@ -107,6 +138,7 @@ class RunProcesses:
                 self.set_parameters()
                 main_log, main, companions = self.start_run(launch or (self.run.launch_path and self.start_launch()))
                 ended = self.wait(main, companions, deadline)
+                raw["cpu_seconds"] = self.cpu_by_process(token, main_log)
             finally:
                 # The metrics are out: the run's processes are killed at once rather than stopped in turn, which
                 # took seconds per run under load. Its master too, then reaped by PrivateMaster.
@@ -122,6 +154,14 @@ class RunProcesses:
         if self.run.rostest_path and ended == "done":
             raw["rostest"] = self.rostest_counts()
         return raw
+
+    @staticmethod
+    def cpu_by_process(token: str, main_log: str) -> dict:
+        """Where the run's CPU went, by process: this process, the main one (waited for, so in this one's
+        children's times) and every other process of the run, still running."""
+        own = os.times()
+        return {**cpu_seconds(token, exclude=(os.getpid(),)), "mbot_batch.run": own.user + own.system,
+                os.path.splitext(main_log)[0]: own.children_user + own.children_system}
 
     def start_launch(self):
         return self.start(["roslaunch", "--wait", self.run.launch_path, *self.launch_arguments()], "launch.log")
