@@ -9,20 +9,22 @@ nothing before; a skid-steer base (skid steer plugin) drives forward at the comm
 plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
 ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo, and
 its f3d reports a wrench /gazebo/apply_body_wrench puts on its base and its pan joint's ft sensor the head's
-weight."""
+weight. Then the rover through twist_mux (test_rover_twist_mux.py), on the same launch."""
 import math
 import unittest
 
 import rospy
 import rostest
 from gazebo_msgs.msg import ContactsState
-from gazebo_msgs.srv import ApplyBodyWrench, DeleteModel, GetModelState, SpawnModel
+from gazebo_msgs.srv import ApplyBodyWrench, DeleteModel, SpawnModel
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
-from sim_support import WALL_TIMEOUT, print_figures, publish_for, wait_for, wait_for_running_controllers
+from sim_support import (WALL_TIMEOUT, init_test_node, model_state_service, print_figures, publish_for, wait_for,
+                         wait_for_running_controllers)
+from test_rover_twist_mux import RoverTwistMux
 
 CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
@@ -69,10 +71,10 @@ class Latest:
 class Rover(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("rover_test")
+        init_test_node("rover_test")
         cls.figures = []
         wait_for_running_controllers(["rover_joint_publisher", CONTROLLER])
-        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.get_model_state = model_state_service()
         cls.imu, cls.fix = Latest("/imu/data", Imu), Latest("/navsat/fix", NavSatFix)
         cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
@@ -307,5 +309,10 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(math.hypot(force.x, force.y), 0.0, delta=0.02 * 0.5 * 9.8)
 
 
+def load_tests(loader, tests, pattern):
+    """This module's cases, then the twist_mux ones: the rover starts those where these left it."""
+    return unittest.TestSuite([loader.loadTestsFromTestCase(Rover), loader.loadTestsFromTestCase(RoverTwistMux)])
+
+
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "rover", Rover)
+    rostest.rosrun("mbot_tests", "rover", "__main__")
