@@ -4,7 +4,7 @@ import sys
 
 import rospy
 from controller_manager_msgs.srv import ListControllers
-from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from gazebo_msgs.srv import GetModelState, GetPhysicsProperties, GetWorldProperties, SetPhysicsProperties
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.processes import wait_until
 from std_srvs.srv import Empty
@@ -52,6 +52,16 @@ def model_state_service():
     the answer. One thread at a time may call it."""
     rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
     return rospy.ServiceProxy("/gazebo/get_model_state", GetModelState, persistent=True)
+
+
+def run_unpaced():
+    """Physics as fast as the machine goes (max_update_rate 0), as a Gazebo user sets it through
+    /gazebo/set_physics_properties. Not for tests that repeat a command on wall time against a timeout."""
+    rospy.wait_for_service("/gazebo/set_physics_properties", timeout=WALL_TIMEOUT)
+    physics = rospy.ServiceProxy("/gazebo/get_physics_properties", GetPhysicsProperties)()
+    answer = rospy.ServiceProxy("/gazebo/set_physics_properties", SetPhysicsProperties)(
+        physics.time_step, 0.0, physics.gravity, physics.ode_config)
+    assert answer.success, answer.status_message
 
 
 def controller_states(list_controllers) -> dict:

@@ -9,11 +9,10 @@ import math
 import unittest
 
 import rospy
-from gazebo_msgs.srv import GetPhysicsProperties, SetPhysicsProperties
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
-from sim_support import Simulator, init_test_node, motion_between, print_figures, roll_pitch_of, wait_for
+from sim_support import Simulator, init_test_node, run_unpaced, motion_between, print_figures, roll_pitch_of, wait_for
 
 SETTLE_SECONDS = 2.0  # a steady command for this long before measuring
 MEASURE_SECONDS = 1.0
@@ -24,10 +23,7 @@ class DriveTracking(unittest.TestCase):
     def setUpClass(cls):
         init_test_node("drive_tracking_test")
         cls.sim = Simulator()
-        physics = rospy.ServiceProxy("/gazebo/get_physics_properties", GetPhysicsProperties)()
-        answer = rospy.ServiceProxy("/gazebo/set_physics_properties", SetPhysicsProperties)(
-            physics.time_step, 0.0, physics.gravity, physics.ode_config)  # max_update_rate 0: no pacing
-        assert answer.success, answer.status_message
+        run_unpaced()
         cls.figures = []
 
     @classmethod
