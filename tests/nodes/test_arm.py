@@ -5,8 +5,7 @@ goal preempts the first; unknown or repeated joints are rejected with INVALID_JO
 topic moves the arm without the action; state and query_state report the trajectory; an elbow commanded past its
 limit stops at it; the gripper opens to its goal (reached_goal), closes on a box and stalls there, its mimic finger
 within 0.001 of the leader; goals past the finger's travel each get a result; a switch_controller pending while
-physics is paused is answered when the arm is deleted, and /clock runs on. Run after the -J cases
-(test_arm_initial_joints.py) on their launch: in the pick world, from the -J pose, homed upright first."""
+physics is paused is answered when the arm is deleted, and /clock runs on."""
 import math
 import threading
 import unittest
@@ -26,8 +25,7 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from sim_support import WALL_TIMEOUT, init_test_node, print_figures, wait_for, wait_for_running_controllers
-from test_arm_initial_joints import ArmInitialJoints
+from sim_support import WALL_TIMEOUT, print_figures, wait_for, wait_for_running_controllers
 
 JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
           "wrist_3_joint"]
@@ -36,7 +34,7 @@ ELBOW_LIMIT = math.radians(160.0)
 # Upright (all joints 0), the gripper base sits 0.85 m up on the mount's axis and the fingers reach 0.03 to
 # 0.09 m above it.
 FINGERS_CENTRE_Z = 0.85 + 0.06
-BOX_SDF = """<sdf version="1.6"><model name="gripped_box"><static>true</static><link name="link">
+BOX_SDF = """<sdf version="1.6"><model name="box"><static>true</static><link name="link">
   <collision name="collision"><geometry><box><size>0.03 0.04 0.03</size></box></geometry></collision>
   <visual name="visual"><geometry><box><size>0.03 0.04 0.03</size></box></geometry></visual>
 </link></model></sdf>"""
@@ -54,7 +52,7 @@ def trajectory(points):
 class Arm(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        init_test_node("arm_test")
+        rospy.init_node("arm_test")
         cls.figures = []
         wait_for_running_controllers(["joint_state_controller", "arm_controller", "gripper_controller"])
         # joint_states comes in parts: the controller's joints, and the mimic finger from the simulator.
@@ -73,11 +71,6 @@ class Arm(unittest.TestCase):
         wait_for(lambda: set(JOINTS + ["right_finger_joint"]) <= set(cls.joint_positions)
                  and cls.controller_state is not None,
                  what="joint_states and the controller's state")
-        # Upright, as spawned without -J: the -J cases, run first on this launch, leave the arm at its -J pose.
-        wait_for(lambda: cls.command.get_num_connections() > 0, what="the controller on the command topic")
-        cls.command.publish(trajectory([(1.5, [0.0] * 6, [0.0] * 6)]))
-        wait_for(lambda: max(abs(cls.joint_positions[name]) for name in JOINTS) < GOAL_TOLERANCE,
-                 what="the arm upright")
 
     @classmethod
     def tearDownClass(cls):
@@ -190,7 +183,7 @@ class Arm(unittest.TestCase):
         rospy.wait_for_service("/gazebo/spawn_sdf_model", timeout=WALL_TIMEOUT)
         pose = Pose()
         pose.position.z, pose.orientation.w = FINGERS_CENTRE_Z, 1.0
-        spawned = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)("gripped_box", BOX_SDF, "", pose, "world")
+        spawned = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)("box", BOX_SDF, "", pose, "world")
         self.assertTrue(spawned.success, spawned.status_message)
         self.gripper.send_goal(GripperCommandGoal(GripperCommand(0.0, 30.0)))
         self.assertTrue(self.gripper.wait_for_result(rospy.Duration(WALL_TIMEOUT)))
@@ -206,7 +199,7 @@ class Arm(unittest.TestCase):
 
     def test_08_goals_past_the_fingers_travel_each_get_a_result(self):
         """The finger travels 0 to 0.04 m: each goal beyond ends (stalled at the limit) within 3 s of sim time."""
-        self.assertTrue(rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)("gripped_box").success)
+        self.assertTrue(rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)("box").success)
         for position in (0.05, -0.01, 1e300, -5.0):
             start = rospy.get_time()
             self.gripper.send_goal(GripperCommandGoal(GripperCommand(position, 30.0)))
@@ -247,10 +240,5 @@ class Arm(unittest.TestCase):
         self.figures.append("switch_controller pending (paused, STRICT, timeout 0) when the arm was deleted: "
                             "answered ok=False")
 
-def load_tests(loader, tests, pattern):
-    """The -J cases first: they read the arm's first joint_states."""
-    return unittest.TestSuite(loader.loadTestsFromTestCase(case) for case in (ArmInitialJoints, Arm))
-
-
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "arm", "__main__")
+    rostest.rosrun("mbot_tests", "arm", Arm)

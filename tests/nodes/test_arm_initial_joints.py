@@ -1,23 +1,24 @@
 #!/usr/bin/env python3
-"""spawn_model -J on the arm (arm.test): the first /joint_states carry the -J positions within 1e-4 rad (m for the
-fingers), the right finger follows its mimic leader, and after a second of sim time the trajectory controller still
-holds them (its desired state within 1e-4 of them). /gazebo/set_model_configuration answers bad requests with
-upstream's message or one naming the value, and nothing moves; spawn_model -J names a joint the model lacks in one
-line and sets the others. get_model_properties and get_link_state answer through ROS with upstream's messages. The
-pick world's link attacher attaches and detaches through its services; names of no model or link answer false and
-move nothing. test_arm.py runs these cases first, then its own on the same launch."""
+"""spawn_model -J on the arm (arm_initial_joints.test): the first /joint_states carry the -J positions within
+1e-4 rad (m for the fingers), the right finger follows its mimic leader, and after a second of sim time the
+trajectory controller still holds them (its desired state within 1e-4 of them). /gazebo/set_model_configuration
+answers bad requests with upstream's message or one naming the value, and nothing moves; spawn_model -J names a
+joint the model lacks in one line and sets the others. get_model_properties and get_link_state answer through ROS
+with upstream's messages. The pick world's link attacher attaches and detaches through its services; names of no
+model or link answer false and move nothing."""
 import math
 import subprocess
 import tempfile
 import unittest
 
 import rospy
+import rostest
 from control_msgs.msg import JointTrajectoryControllerState
 from gazebo_msgs.srv import GetLinkState, GetModelProperties, GetModelState, SetModelConfiguration
 from gazebo_ros_link_attacher.srv import Attach
 from sensor_msgs.msg import JointState
 
-from sim_support import init_test_node, print_figures, wait_for, wait_for_running_controllers
+from sim_support import print_figures, wait_for, wait_for_running_controllers
 
 INITIAL = {"shoulder_pan_joint": 4.0, "shoulder_lift_joint": -1.2, "elbow_joint": 1.5, "wrist_1_joint": -0.9,
            "wrist_2_joint": 0.7, "wrist_3_joint": 0.4, "left_finger_joint": 0.03, "right_finger_joint": 0.03}
@@ -29,7 +30,6 @@ ACTUAL_TOLERANCE = 5e-3
 class ArmInitialJoints(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        init_test_node("arm_initial_joints_test")
         cls.first_positions = {}  # each joint's first position (the mimic finger comes in a message of its own)
 
         def on_joint_states(message):
@@ -147,3 +147,8 @@ PENDULUM_URDF = """<robot name="pendulum">
     <inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <joint name="hinge" type="continuous"><parent link="base"/><child link="bob"/><axis xyz="1 0 0"/></joint>
 </robot>"""
+
+
+if __name__ == "__main__":
+    rospy.init_node("arm_initial_joints_test")
+    rostest.rosrun("mbot_tests", "arm_initial_joints", ArmInitialJoints)
