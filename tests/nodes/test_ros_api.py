@@ -122,6 +122,7 @@ class RosApi(unittest.TestCase):
         subscriber = rospy.Subscriber("/clock", Clock, lambda message: clocks.append(message.clock.to_sec()))
         wait_for(lambda: len(clocks) > 10, what="/clock messages")
         self.sim.pause()
+        self.addCleanup(self.sim.unpause)  # whatever fails below: the cases after this one need the clock
         paused_at = len(clocks)
         # Twenty answers of the simulator itself, each measured in one of its loop passes: a running simulator
         # steps between any two of them, a paused one gives one time throughout, and /clock stays put.

@@ -9,7 +9,7 @@ nothing before; a skid-steer base (skid steer plugin) drives forward at the comm
 plugin) drives and steers as its kinematics say, publishes its joints, and its block laser's points lie on the
 ground ahead; a stereo head publishes its left and right images with the baseline in the right CameraInfo, and
 its f3d reports a wrench /gazebo/apply_body_wrench puts on its base and its pan joint's ft sensor the head's
-weight. Then the rover through twist_mux (test_rover_twist_mux.py), on the same launch."""
+weight."""
 import math
 import unittest
 
@@ -22,9 +22,8 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
-from sim_support import (WALL_TIMEOUT, init_test_node, model_state_service, print_figures, publish_for, wait_for,
+from sim_support import (WALL_TIMEOUT, model_state_service, print_figures, publish_for, wait_for,
                          wait_for_running_controllers)
-from test_rover_twist_mux import RoverTwistMux
 
 CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
@@ -71,7 +70,7 @@ class Latest:
 class Rover(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        init_test_node("rover_test")
+        rospy.init_node("rover_test")
         cls.figures = []
         wait_for_running_controllers(["rover_joint_publisher", CONTROLLER])
         cls.get_model_state = model_state_service()
@@ -309,10 +308,5 @@ class Rover(unittest.TestCase):
         self.assertAlmostEqual(math.hypot(force.x, force.y), 0.0, delta=0.02 * 0.5 * 9.8)
 
 
-def load_tests(loader, tests, pattern):
-    """This module's cases, then the twist_mux ones: the rover starts those where these left it."""
-    return unittest.TestSuite([loader.loadTestsFromTestCase(Rover), loader.loadTestsFromTestCase(RoverTwistMux)])
-
-
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "rover", "__main__")
+    rostest.rosrun("mbot_tests", "rover", Rover)

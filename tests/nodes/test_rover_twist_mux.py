@@ -3,18 +3,18 @@
 speed; the joystick's topic (priority 10) overrides /cmd_vel and /cmd_vel takes over again 0.5 s after the
 joystick stops; true on /e_stop (priority 255) stops it from 0.15 m/s within 0.1 s of sim time while /cmd_vel
 keeps coming, and false lets /cmd_vel drive again; feedback of the rviz twist marker drives it through the
-marker server. Run by test_rover.py after its own cases, on rover.test's launch."""
+marker server."""
 import math
 import unittest
 
 import rospy
+import rostest
 from gazebo_msgs.msg import ModelStates
 from geometry_msgs.msg import Pose, Twist
 from std_msgs.msg import Bool
 from visualization_msgs.msg import InteractiveMarkerFeedback
 
-from sim_support import (init_test_node, print_figures, publish_for, twist, wait_for, wait_for_running_controllers,
-                         yaw_of)
+from sim_support import print_figures, publish_for, twist, wait_for, wait_for_running_controllers, yaw_of
 
 CONTROLLER = "rover_velocity_controller"
 # The e-stop's limit, and what "stopped" means for the ground truth: the rover's speed (m/s).
@@ -26,7 +26,7 @@ E_STOP_SPEED = 0.15
 class RoverTwistMux(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        init_test_node("rover_twist_mux_test")
+        rospy.init_node("rover_twist_mux_test")
         cls.figures = []
         cls.truth = []  # (sim time, forward speed, yaw rate, height) from /gazebo/model_states
         cls.mux_out = []  # (sim time, Twist) that twist_mux sent the controller
@@ -127,3 +127,6 @@ class RoverTwistMux(unittest.TestCase):
         self.figures.append(f"rover on the twist marker's feedback (x 0.25 m, scale 1): {forward:.3f} m/s")
         self.assertAlmostEqual(forward, 0.25, delta=0.015)
 
+
+if __name__ == "__main__":
+    rostest.rosrun("mbot_tests", "rover_twist_mux", RoverTwistMux)
