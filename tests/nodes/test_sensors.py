@@ -105,6 +105,8 @@ class CameraAndImu(unittest.TestCase):
         rospy.init_node("sensors_test")
         # No Simulator(): it drives /cmd_vel, and these robots listen in their own namespaces.
         cls.sim = SimpleNamespace(get_model_state=model_state_service())
+        # The bridge offers its services one by one: get_model_state up does not mean get_world_properties is.
+        rospy.wait_for_service("/gazebo/get_world_properties", timeout=WALL_TIMEOUT)
         properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
         for model in ("camera_bot", "imu_bot"):
             wait_for(lambda: model in properties().model_names, what="model " + model)
