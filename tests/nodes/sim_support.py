@@ -4,7 +4,7 @@ import sys
 
 import rospy
 from controller_manager_msgs.srv import ListControllers
-from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from gazebo_msgs.srv import GetModelState, GetPhysicsProperties, GetWorldProperties, SetPhysicsProperties
 from geometry_msgs.msg import Twist
 from mbot_sim_bridge.processes import wait_until
 from std_srvs.srv import Empty
@@ -16,6 +16,12 @@ WALL_TIMEOUT = 60.0
 def wait_for(condition, timeout=WALL_TIMEOUT, what="condition"):
     """``condition``'s truthy value, polled for at most ``timeout`` wall seconds (then AssertionError)."""
     return wait_until(condition, timeout, what)
+
+
+def init_test_node(name):
+    """rospy.init_node, once per process: a test node may run the test cases of several modules on one launch."""
+    if not rospy.core.is_initialized():
+        rospy.init_node(name)
 
 
 def twist(linear=0.0, angular=0.0) -> Twist:
@@ -38,6 +44,24 @@ def publish_for(sim_seconds, *publications):
 def print_figures(lines):
     """A test's measurements, one ``figure:`` line each on stderr, where ./mbot test picks them up."""
     print("\n".join([""] + ["figure: " + line for line in lines]), file=sys.stderr)
+
+
+def model_state_service():
+    """/gazebo/get_model_state on one connection kept open: tests poll it every 20 ms, and a connection per call
+    (a master lookup, a socket and a server thread) costs the master, the simulator and the test more CPU than
+    the answer. One thread at a time may call it."""
+    rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
+    return rospy.ServiceProxy("/gazebo/get_model_state", GetModelState, persistent=True)
+
+
+def run_unpaced():
+    """Physics as fast as the machine goes (max_update_rate 0), as a Gazebo user sets it through
+    /gazebo/set_physics_properties. Not for tests that repeat a command on wall time against a timeout."""
+    rospy.wait_for_service("/gazebo/set_physics_properties", timeout=WALL_TIMEOUT)
+    physics = rospy.ServiceProxy("/gazebo/get_physics_properties", GetPhysicsProperties)()
+    answer = rospy.ServiceProxy("/gazebo/set_physics_properties", SetPhysicsProperties)(
+        physics.time_step, 0.0, physics.gravity, physics.ode_config)
+    assert answer.success, answer.status_message
 
 
 def controller_states(list_controllers) -> dict:
@@ -87,7 +111,7 @@ class Simulator:
         for service in ("get_model_state", "get_world_properties", "reset_world", "pause_physics",
                         "unpause_physics", "reset_simulation"):
             rospy.wait_for_service("/gazebo/" + service, timeout=WALL_TIMEOUT)
-        self.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        self.get_model_state = model_state_service()
         self.world_properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
         self.reset_world = rospy.ServiceProxy("/gazebo/reset_world", Empty)
         self.reset_simulation = rospy.ServiceProxy("/gazebo/reset_simulation", Empty)
@@ -110,5 +134,7 @@ class Simulator:
     def wait_sim_time(self, seconds):
         """Wait until ``seconds`` of sim time have passed; returns the ground truth then."""
         start = self.truth()[0]
+        # On this node's clock first (no call to the simulator), then the truth, measured at that time or later.
+        wait_for(lambda: rospy.get_time() >= start + seconds, what=f"{seconds:.1f} s of sim time")
         return wait_for(lambda: (lambda truth: truth if truth[0] >= start + seconds else None)(self.truth()),
                         what=f"{seconds:.1f} s of sim time")

@@ -8,11 +8,11 @@ import unittest
 import rospy
 import rostest
 from controller_manager_msgs.srv import ListControllers
-from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, publish_for, twist, wait_for, yaw_of
+from sim_support import (WALL_TIMEOUT, controller_states, model_state_service, print_figures, publish_for, twist,
+                         wait_for, yaw_of)
 
 WHEELBASE = 0.4
 
@@ -27,8 +27,7 @@ class Car(unittest.TestCase):
         wait_for(lambda: controller_states(list_controllers) == {"joint_state_controller": "running",
                                                                   "car_controller": "running"},
                  what="the spawner to start both controllers")
-        rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
-        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.get_model_state = model_state_service()
         cls.cmd_vel = rospy.Publisher("/car_controller/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
 

@@ -1,17 +1,18 @@
 #!/usr/bin/env python3
 """The course's mbot, its xacro unchanged, drives as it does in Gazebo: speeds, turning, staying level, odom.
 
-Prints the measured figures; each is checked against the tolerance of the workspace's acceptance list.
+Prints the measured figures; each is checked against the tolerance of the workspace's acceptance list. Run by
+test_ros_api.py after its own cases, on ros_api.test's launch (the same world and robot): it sets the physics to
+run as fast as the machine goes, as a Gazebo user does through /gazebo/set_physics_properties.
 """
 import math
 import unittest
 
 import rospy
-import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
-from sim_support import Simulator, motion_between, print_figures, roll_pitch_of, wait_for
+from sim_support import Simulator, init_test_node, run_unpaced, motion_between, print_figures, roll_pitch_of, wait_for
 
 SETTLE_SECONDS = 2.0  # a steady command for this long before measuring
 MEASURE_SECONDS = 1.0
@@ -20,8 +21,9 @@ MEASURE_SECONDS = 1.0
 class DriveTracking(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("drive_tracking_test")
+        init_test_node("drive_tracking_test")
         cls.sim = Simulator()
+        run_unpaced()
         cls.figures = []
 
     @classmethod
@@ -102,6 +104,3 @@ class DriveTracking(unittest.TestCase):
         subscriber.unregister()
         self.sim.command(0.0, 0.0)
 
-
-if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "drive_tracking", DriveTracking)

@@ -1,26 +1,25 @@
 #!/usr/bin/env python3
 """joystick_relay.py: a joystick Twist scaled by the turbo step (joystick.yaml: four steps, the second at
 start), the turbo and priority actions, joy_priority and its text marker, and invalid input (out of range, NaN,
-inf) answered with a zero Twist and one error per kind."""
+inf) answered with a zero Twist and one error per kind. Run by test_twist_mux.py, on twist_mux.test's launch."""
 import math
 import unittest
 
 import actionlib
 import rospy
-import rostest
 from geometry_msgs.msg import Twist
 from rosgraph_msgs.msg import Log
 from std_msgs.msg import Bool
 from twist_mux_msgs.msg import JoyPriorityAction, JoyPriorityGoal, JoyTurboAction, JoyTurboGoal
 from visualization_msgs.msg import Marker
 
-from sim_support import WALL_TIMEOUT, twist, wait_for
+from sim_support import WALL_TIMEOUT, init_test_node, twist, wait_for
 
 
 class JoystickRelay(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("joystick_relay_test")
+        init_test_node("joystick_relay_test")
         cls.out, cls.priority, cls.errors = [], [], []
         rospy.Subscriber("joy_vel_out", Twist, cls.out.append)
         rospy.Subscriber("joy_priority", Bool, lambda message: cls.priority.append(message.data))
@@ -74,6 +73,3 @@ class JoystickRelay(unittest.TestCase):
         wait_for(lambda: self.priority[-1] is True and self.out and self.out[-1] == Twist(),
                  what="joy_priority true and a zero Twist")
 
-
-if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "joystick_relay", JoystickRelay)

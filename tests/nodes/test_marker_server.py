@@ -1,18 +1,17 @@
 #!/usr/bin/env python3
 """marker_server: its marker (name, frame, controls for x, y and the turn), feedback to Twist with upstream's
 scales and limits, the marker snapped back after each feedback, and bad poses (NaN, inf, a zero quaternion)
-refused with one warning each while the node keeps serving."""
+refused with one warning each while the node keeps serving. Run by test_twist_mux.py, on twist_mux.test's launch."""
 import math
 import time
 import unittest
 
 import rospy
-import rostest
 from geometry_msgs.msg import Pose, Twist
 from rosgraph_msgs.msg import Log
 from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit, InteractiveMarkerUpdate
 
-from sim_support import WALL_TIMEOUT, wait_for
+from sim_support import WALL_TIMEOUT, init_test_node, wait_for
 
 
 
@@ -30,7 +29,7 @@ def feedback(x=0.0, y=0.0, yaw=0.0, orientation=None):
 class MarkerServer(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("marker_server_test")
+        init_test_node("marker_server_test")
         cls.twists, cls.updates, cls.warnings = [], [], []
         rospy.Subscriber("/twist_marker_server/cmd_vel", Twist, cls.twists.append)
         rospy.Subscriber("/twist_marker_server/update", InteractiveMarkerUpdate, cls.updates.append)
@@ -90,6 +89,3 @@ class MarkerServer(unittest.TestCase):
         wait_for(lambda: [text for text in self.warnings if "clamped" in text], what="the huge offset said")
         self.assertEqual(len([text for text in self.warnings if "clamped" in text]), 1)
 
-
-if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "marker_server", MarkerServer)

@@ -7,12 +7,12 @@ import unittest
 
 import rospy
 import rostest
-from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from gazebo_msgs.srv import GetWorldProperties
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
 
-from sim_support import WALL_TIMEOUT, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, model_state_service, wait_for, yaw_of
 
 COUNT = 10
 ROBOTS = [f"mbot_{index}" for index in range(1, COUNT + 1)]
@@ -27,7 +27,7 @@ class MultiMbot(unittest.TestCase):
         rospy.wait_for_service("/gazebo/get_world_properties", timeout=WALL_TIMEOUT)
         world = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
         wait_for(lambda: set(ROBOTS) <= set(world().model_names), timeout=240, what=f"{COUNT} robots")
-        cls.state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.state = model_state_service()
         cls.lock = threading.Lock()
         cls.odom, cls.scans = {}, {}
         cls.subscribers = []

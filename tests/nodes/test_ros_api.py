@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """The bridge exposes gazebo_ros's ROS API (checked against gazebo_api.yaml through rosgraph, not CLI text),
-with one publisher per transform and per joint, and Gazebo's pause and reset behaviour."""
+with one publisher per transform and per joint, and Gazebo's pause and reset behaviour; then the /gazebo services
+(gazebo_services.py) and the drive tracking (test_drive_tracking.py) in the same world: rostest starts the launch
+again for each <test>."""
 import collections
 import sys
 import time
@@ -17,8 +19,9 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
-from gazebo_services import GazeboServices  # noqa: F401 (run by rosrun below, in this world)
+from gazebo_services import GazeboServices
 from sim_support import Simulator, wait_for
+from test_drive_tracking import DriveTracking
 
 
 class RosApi(unittest.TestCase):
@@ -119,6 +122,7 @@ class RosApi(unittest.TestCase):
         subscriber = rospy.Subscriber("/clock", Clock, lambda message: clocks.append(message.clock.to_sec()))
         wait_for(lambda: len(clocks) > 10, what="/clock messages")
         self.sim.pause()
+        self.addCleanup(self.sim.unpause)  # whatever fails below: the cases after this one need the clock
         paused_at = len(clocks)
         # Twenty answers of the simulator itself, each measured in one of its loop passes: a running simulator
         # steps between any two of them, a paused one gives one time throughout, and /clock stays put.
@@ -134,5 +138,11 @@ class RosApi(unittest.TestCase):
         subscriber.unregister()
 
 
+def load_tests(loader, tests, pattern):
+    """The services, this module's cases, then the drive tracking: it takes the pacing off, which
+    test_the_simulation_keeps_the_worlds_real_time_factor needs."""
+    return unittest.TestSuite(loader.loadTestsFromTestCase(case) for case in (GazeboServices, RosApi, DriveTracking))
+
+
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "ros_api", "__main__")  # RosApi and GazeboServices
+    rostest.rosrun("mbot_tests", "ros_api", "__main__")

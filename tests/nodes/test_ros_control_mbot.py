@@ -20,7 +20,9 @@ from rosgraph_msgs.msg import Log
 from sim_support import WALL_TIMEOUT, Simulator, controller_states, motion_between, print_figures, wait_for
 
 CONTROLLER = "mobile_base_controller"
-SETTLE_SECONDS = 2.0
+# diff_drive_controller's limits (mbot_ros_control.yaml: 1.8 m/s², 10 rad/s²) reach every commanded speed here
+# within 0.12 s; a second settles the wheels' own loop behind them before the measurement.
+SETTLE_SECONDS = 1.0
 MEASURE_SECONDS = 1.0
 STRICT, BEST_EFFORT = SwitchControllerRequest.STRICT, SwitchControllerRequest.BEST_EFFORT
 

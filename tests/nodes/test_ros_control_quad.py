@@ -11,12 +11,12 @@ import unittest
 import rospy
 import rostest
 from controller_manager_msgs.srv import ListControllers
-from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from mbot_sim_bridge.processes import stop_process_group
-from sim_support import WALL_TIMEOUT, controller_states, print_figures, publish_for, twist, wait_for, yaw_of
+from sim_support import (WALL_TIMEOUT, controller_states, model_state_service, print_figures, publish_for, twist,
+                         wait_for, yaw_of)
 
 CONTROLLER = "quad_velocity_controller"
 # quad_base.urdf.xacro's default geometry and quad_control.yaml's multiplier (Husky's).
@@ -32,8 +32,7 @@ class RosControlQuad(unittest.TestCase):
         cls.list_controllers = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
         wait_for(lambda: cls.states() == {"quad_joint_publisher": "running", CONTROLLER: "running"},
                  what="the spawner to start both controllers")
-        rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
-        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.get_model_state = model_state_service()
         cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")
 

@@ -16,13 +16,14 @@ import unittest
 import rospy
 import rostest
 from gazebo_msgs.msg import ContactsState
-from gazebo_msgs.srv import ApplyBodyWrench, DeleteModel, GetModelState, SpawnModel
+from gazebo_msgs.srv import ApplyBodyWrench, DeleteModel, SpawnModel
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, NavSatFix, PointCloud, PointCloud2, Range
 from sensor_msgs import point_cloud2
 
-from sim_support import WALL_TIMEOUT, print_figures, publish_for, wait_for, wait_for_running_controllers
+from sim_support import (WALL_TIMEOUT, model_state_service, print_figures, publish_for, wait_for,
+                         wait_for_running_controllers)
 
 CONTROLLER = "rover_velocity_controller"
 # WGS84, as hector's GPS converts: metres per radian of latitude at the reference latitude (49.9 deg).
@@ -72,7 +73,7 @@ class Rover(unittest.TestCase):
         rospy.init_node("rover_test")
         cls.figures = []
         wait_for_running_controllers(["rover_joint_publisher", CONTROLLER])
-        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.get_model_state = model_state_service()
         cls.imu, cls.fix = Latest("/imu/data", Imu), Latest("/navsat/fix", NavSatFix)
         cls.cmd_vel = rospy.Publisher(f"/{CONTROLLER}/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, what="the controller to subscribe cmd_vel")

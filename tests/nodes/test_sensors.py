@@ -12,11 +12,11 @@ import numpy
 import rospy
 import rostest
 import tf2_ros
-from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from gazebo_msgs.srv import GetWorldProperties
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, PointCloud2, Range
 
-from sim_support import WALL_TIMEOUT, Simulator, wait_for, yaw_of
+from sim_support import WALL_TIMEOUT, Simulator, model_state_service, wait_for, yaw_of
 
 WALL_X = 1.65  # the wall's near face in the world (sensor_wall.world)
 PLATE = (2.495, 4.4, 0.3)  # the red plate's near-face centre
@@ -104,8 +104,9 @@ class CameraAndImu(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("sensors_test")
         # No Simulator(): it drives /cmd_vel, and these robots listen in their own namespaces.
-        rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
-        cls.sim = SimpleNamespace(get_model_state=rospy.ServiceProxy("/gazebo/get_model_state", GetModelState))
+        cls.sim = SimpleNamespace(get_model_state=model_state_service())
+        # The bridge offers its services one by one: get_model_state up does not mean get_world_properties is.
+        rospy.wait_for_service("/gazebo/get_world_properties", timeout=WALL_TIMEOUT)
         properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
         for model in ("camera_bot", "imu_bot"):
             wait_for(lambda: model in properties().model_names, what="model " + model)

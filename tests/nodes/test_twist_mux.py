@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """twist_mux against upstream's system scenarios (no input: no output; one input passes; a higher priority
 overrides and the lower one resumes when it times out), then the locks (strictly-below masking, a heartbeat
-lock that times out, the zero Twist when a lock engages), NaN, inf and huge values, and the diagnostics."""
+lock that times out, the zero Twist when a lock engages), NaN, inf and huge values, and the diagnostics. Then, in
+this node on the same launch (rostest starts the launch again for each <test>), joystick_relay.py
+(test_joystick_relay.py) and the twist marker server (test_marker_server.py)."""
 import math
 import threading
 import time
@@ -14,7 +16,9 @@ from geometry_msgs.msg import Twist
 from rosgraph_msgs.msg import Log
 from std_msgs.msg import Bool
 
-from sim_support import twist, wait_for
+from sim_support import init_test_node, twist, wait_for
+from test_joystick_relay import JoystickRelay
+from test_marker_server import MarkerServer
 
 # The configuration's longest input timeout (input1), and a margin for the messages in flight.
 LONGEST_INPUT_TIMEOUT = 0.7
@@ -53,7 +57,7 @@ class RatePublishers:
 class TwistMuxSystem(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        rospy.init_node("twist_mux_system_test")
+        init_test_node("twist_mux_system_test")
         cls.received = []
         cls.warnings = []
         cls.diagnostics = []
@@ -160,5 +164,10 @@ class TwistMuxSystem(unittest.TestCase):
         self.assertEqual(values["current priority"], "0")
 
 
+def load_tests(loader, tests, pattern):
+    return unittest.TestSuite(loader.loadTestsFromTestCase(case) for case in (TwistMuxSystem, JoystickRelay,
+                                                                                MarkerServer))
+
+
 if __name__ == "__main__":
-    rostest.rosrun("mbot_tests", "twist_mux_system", TwistMuxSystem)
+    rostest.rosrun("mbot_tests", "twist_mux_system", "__main__")

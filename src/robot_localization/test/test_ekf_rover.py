@@ -10,7 +10,6 @@ import rospkg
 import rospy
 import rostest
 import tf2_ros
-from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import PoseWithCovarianceStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
@@ -20,7 +19,7 @@ from robot_localization.srv import SetPose
 
 # The workspace's rostest helpers (waiting on conditions, yaw of a quaternion) live in mbot_tests' nodes.
 sys.path.insert(0, os.path.join(rospkg.RosPack().get_path("mbot_tests"), "nodes"))
-from sim_support import WALL_TIMEOUT, wait_for, yaw_of  # noqa: E402
+from sim_support import WALL_TIMEOUT, model_state_service, wait_for, yaw_of  # noqa: E402
 
 # The node runs Clearpath's configuration with smooth_lagged_data: on a loaded machine its callbacks run late,
 # and without smoothing data arriving after sensor_timeout (1/frequency here) is fused after the prediction went
@@ -55,8 +54,7 @@ class EkfRover(unittest.TestCase):
                                                                                        Odometry)
         cls.logs = []
         rospy.Subscriber("/rosout", Log, cls.logs.append, queue_size=100)
-        rospy.wait_for_service("/gazebo/get_model_state", timeout=WALL_TIMEOUT)
-        cls.get_model_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.get_model_state = model_state_service()
         cls.tf_buffer = tf2_ros.Buffer()
         cls.tf_listener = tf2_ros.TransformListener(cls.tf_buffer)
         cls.cmd_vel = rospy.Publisher("/rover_velocity_controller/cmd_vel", Twist, queue_size=1)
