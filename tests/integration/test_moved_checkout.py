@@ -19,7 +19,7 @@ COPIED = (".catkin_workspace", "mbot", "worlds", "build", "devel")
 # message packages left out were most of the rebuild's CPU (63 s of CPU with all of them, 14 s with these).
 COPIED_PACKAGES = ("CMakeLists.txt", "mbot_gazebo", "mbot_description", "mbot_sim_bridge", "gazebo_ros", "xacro")
 # Likewise the venv: setup makes it again and installs the requirements, the same for each; the copy's
-# requirements.txt keeps xacro alone, which setup's hook adapts (pybullet, dask and the rest were 9 of the 14 s).
+# requirements.txt keeps xacro alone, which setup's hook adapts (installing the whole list took 10 CPU s, xacro 1).
 KEPT_REQUIREMENTS = ("xacro==",)
 
 
