@@ -8,6 +8,7 @@ The Python files a ``.test`` file runs as test nodes are not collected by pytest
 import logging
 import re
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 from xml.etree import ElementTree
@@ -16,6 +17,11 @@ import pytest
 from mbot_sim_bridge.core.log import forget_warnings
 
 ROOT = Path(__file__).resolve().parent
+# pytest keeps the test modules it rewrote for their asserts (and the plugin packages it rewrites) in __pycache__,
+# as Python keeps bytecode, unless writing bytecode is off (PYTHONDONTWRITEBYTECODE, common in containers): then
+# every worker rewrote every module at every run, half the CPU of collecting the suite. ./mbot setup collects once
+# to write them; a changed module is written again by the run that meets it.
+sys.dont_write_bytecode = False
 ROSTEST_GLOBS = ("src/*/test/*.test", "tests/*.test")
 # The longest rostest file takes under a minute; one that hangs is stopped and counted as failed.
 ROSTEST_TIMEOUT_SECONDS = 600

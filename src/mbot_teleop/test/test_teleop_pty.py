@@ -58,9 +58,10 @@ def start_teleop(ros_env):
     started = []
 
     def start(*ros_args, wait_ready=True):
+        """wait_ready=False: a teleop expected to exit at once, whose commands nobody records (recorder None)."""
         n = next(_ids)
         topic = f'/pty_test_{n}/cmd_vel'
-        recorder = TwistRecorder(topic, ros_env)
+        recorder = TwistRecorder(topic, ros_env) if wait_ready else None
         command = teleop_command(f'__name:=mbot_teleop_{n}', f'cmd_vel:={topic}', *ros_args)
         teleop = PtyProcess(command, ros_env)
         started.append((teleop, recorder))
@@ -72,7 +73,33 @@ def start_teleop(ros_env):
     yield start
     for teleop, recorder in started:
         teleop.close()
+        if recorder is not None:
+            recorder.close()
+
+
+@pytest.fixture(scope='module')
+def module_teleop(ros_env):
+    """One teleop with the default parameters for the tests that leave it at rest at the default speeds (no
+    speed key, no exit): a teleop's start-up is most of such a test's CPU."""
+    topic = '/pty_test_shared/cmd_vel'
+    recorder = TwistRecorder(topic, ros_env)
+    teleop = PtyProcess(teleop_command('__name:=mbot_teleop_shared', f'cmd_vel:={topic}'), ros_env)
+    try:
+        assert wait_until(lambda: len(recorder), START_TIMEOUT), teleop.output
+        yield teleop, recorder
+    finally:
+        teleop.close()
         recorder.close()
+
+
+@pytest.fixture
+def default_teleop(module_teleop):
+    """The module's default teleop, stopped (space) before the test whatever ran before it."""
+    teleop, recorder = module_teleop
+    start = len(recorder)
+    teleop.send(' ')
+    assert wait_until(lambda: recorder.commands(start)[-1:] == [STOP], STEP_TIMEOUT), recorder.commands(start)
+    return module_teleop
 
 
 def drive(teleop, recorder, keys, count):
@@ -105,8 +132,8 @@ def ramp(first, last, step, direction=1):
     return [n * step * direction for n in range(first, last + sign, sign)]
 
 
-def test_starts_raw_prints_help_speeds_and_params(start_teleop):
-    teleop, recorder = start_teleop()
+def test_starts_raw_prints_help_speeds_and_params(default_teleop):
+    teleop, recorder = default_teleop
     assert not teleop.mode()[tty.LFLAG] & RAW_FLAGS
     assert teleop.wait_for_output('currently:\tspeed 0.2\tturn 1.0', STEP_TIMEOUT), teleop.output
     assert 'Control mbot!' in teleop.output
@@ -115,8 +142,8 @@ def test_starts_raw_prints_help_speeds_and_params(start_teleop):
             f'publishing on {recorder.topic}') in teleop.output
 
 
-def test_move_keys_ramp_toward_their_direction(start_teleop):
-    teleop, recorder = start_teleop()
+def test_move_keys_ramp_toward_their_direction(default_teleop):
+    teleop, recorder = default_teleop
     for key, (x, th) in MOVES.items():
         got = drive(teleop, recorder, key * 10 + ' ', 11)
         expected = list(zip(ramp(1, 10, 0.02, x), ramp(1, 10, 0.1, th))) + [STOP]
@@ -124,15 +151,15 @@ def test_move_keys_ramp_toward_their_direction(start_teleop):
     assert all(fields[1:5] == (0, 0, 0, 0) for fields in recorder.messages)
 
 
-def test_stop_keys_stop_at_once(start_teleop):
-    teleop, recorder = start_teleop()
+def test_stop_keys_stop_at_once(default_teleop):
+    teleop, recorder = default_teleop
     for stop_key in ' k':
         got = drive(teleop, recorder, 'u' * 5 + stop_key, 6)
         assert_commands(got, list(zip(ramp(1, 5, 0.02), ramp(1, 5, 0.1))) + [STOP])
 
 
-def test_idle_stop_ramps_down_after_five_idle_polls(start_teleop):
-    teleop, recorder = start_teleop()
+def test_idle_stop_ramps_down_after_five_idle_polls(default_teleop):
+    teleop, recorder = default_teleop
     # No key after the ramp: four idle polls keep the target, the fifth drops it to zero.
     got = drive(teleop, recorder, 'i' * 10, 24)
     linear = ramp(1, 10, 0.02) + [0.2] * 4 + ramp(9, 0, 0.02)
@@ -185,8 +212,8 @@ def test_exit_publishes_zero_twist_and_restores_the_terminal(start_teleop, endin
     (('_speed:=0.3', '_turn:=0.5', '_scale_linear:=0.1', '_scale_angular:=0.4'), 0.3, 0.5,
      'speed 0.3 m/s (~speed), turn 0.5 rad/s (~turn)'),
 ], ids=['defaults', 'course-params', 'speed-beats-scale'])
-def test_speed_params_set_the_starting_speeds(start_teleop, ros_args, speed, turn, log):
-    teleop, recorder = start_teleop(*ros_args)
+def test_speed_params_set_the_starting_speeds(request, start_teleop, ros_args, speed, turn, log):
+    teleop, recorder = start_teleop(*ros_args) if ros_args else request.getfixturevalue('default_teleop')
     assert teleop.wait_for_output(log, STEP_TIMEOUT), teleop.output
     assert teleop.wait_for_output(f'currently:\tspeed {speed}\tturn {turn}', STEP_TIMEOUT)
     if '_speed:=0.3' in ros_args:

@@ -4,7 +4,7 @@ import os
 import threading
 
 import yaml
-from sensor_fixtures import WORKSPACE_SRC
+from sensor_fixtures import WORKSPACE_SRC, expanded
 
 from mbot_sim_bridge.core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
 from mbot_sim_bridge.core.parameters import Parameters
@@ -12,7 +12,6 @@ from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
-from mbot_sim_bridge.robot_description import expand_xacro
 
 WORLDS = os.path.join(WORKSPACE_SRC, "..", "worlds")
 MBOT_YAML = os.path.join(WORKSPACE_SRC, "mbot_gazebo", "config", "mbot_ros_control.yaml")
@@ -77,11 +76,11 @@ def recording_batches(sim):
 
 
 def expand_xacro_arm(interface):
-    return expand_xacro(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"), interface=interface)
+    return expanded(os.path.join(ROBOTS, "urdf", "two_joint_arm.urdf.xacro"), interface=interface)
 
 
 def expand_xacro_car(steering):
-    return expand_xacro(CAR, steering=steering)
+    return expanded(CAR, steering=steering)
 
 
 def car(steering):

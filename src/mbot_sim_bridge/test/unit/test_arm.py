@@ -5,20 +5,20 @@ import os
 
 import pytest
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, run_until_ended, simulate, start_controllers
+from sensor_fixtures import expanded
 
 from mbot_sim_bridge.core.ros_control.gripper_action_controller import GripperGoal
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.ros_control.joint_trajectory_controller import (
     ABORTED, SUCCEEDED, SUCCESSFUL, JointTrajectory, TrajectoryGoal, TrajectoryPoint)
 from mbot_sim_bridge.package_uris import resolve_package_uris
-from mbot_sim_bridge.robot_description import expand_xacro
 
 ARM_XACRO = os.path.join(WORKSPACE_SRC, "arm_description", "urdf", "arm.urdf.xacro")
 CONFIG = os.path.join(WORKSPACE_SRC, "arm_gazebo", "config", "arm_{}_controllers.yaml")
 
 
 def arm(interface):
-    urdf = expand_xacro(ARM_XACRO,
+    urdf = expanded(ARM_XACRO,
                         transmission_hw_interface=f"hardware_interface/{interface.capitalize()}JointInterface")
     assert "package://arm_description/meshes/collision/upper_arm.stl" in urdf
     sim, spawned, plugin = simulate(urdf, load_yaml(CONFIG.format(interface)), "robot",

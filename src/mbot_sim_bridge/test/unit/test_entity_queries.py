@@ -6,12 +6,12 @@ import os
 import numpy as np
 import pytest
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, simulate
+from sensor_fixtures import expanded
 
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import IDENTITY, compose, inverse
 from mbot_sim_bridge.package_uris import resolve_package_uris
-from mbot_sim_bridge.robot_description import expand_xacro
 
 ARM_XACRO = os.path.join(WORKSPACE_SRC, "arm_description", "urdf", "arm.urdf.xacro")
 CONFIG = os.path.join(WORKSPACE_SRC, "arm_gazebo", "config", "arm_effort_controllers.yaml")
@@ -24,7 +24,7 @@ FRAME_NOT_FOUND = "GetLinkState: reference reference_frame not found, did you fo
 
 @pytest.fixture
 def world(tmp_path):
-    sim, spawned, _ = simulate(expand_xacro(ARM_XACRO), load_yaml(CONFIG), "robot",
+    sim, spawned, _ = simulate(expanded(ARM_XACRO), load_yaml(CONFIG), "robot",
                                package_uris=resolve_package_uris, namespace="/")
     path = tmp_path / "box.world"
     path.write_text(BOX_WORLD)

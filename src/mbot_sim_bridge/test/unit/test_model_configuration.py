@@ -6,11 +6,11 @@ import os
 
 import pytest
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, simulate, start_controllers, switch_stepping
+from sensor_fixtures import expanded
 
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.package_uris import resolve_package_uris
-from mbot_sim_bridge.robot_description import expand_xacro
 
 ARM_XACRO = os.path.join(WORKSPACE_SRC, "arm_description", "urdf", "arm.urdf.xacro")
 CONFIG = os.path.join(WORKSPACE_SRC, "arm_gazebo", "config", "arm_{}_controllers.yaml")
@@ -23,7 +23,7 @@ POSE = [4.0, -1.2, 1.5, -0.9, 0.7, 0.4]
 @pytest.fixture(params=["effort", "position"])
 def arm(request):
     interface = request.param
-    urdf = expand_xacro(ARM_XACRO,
+    urdf = expanded(ARM_XACRO,
                         transmission_hw_interface=f"hardware_interface/{interface.capitalize()}JointInterface")
     sim, spawned, plugin = simulate(urdf, load_yaml(CONFIG.format(interface)), "robot",
                                     package_uris=resolve_package_uris, namespace="/")

@@ -7,20 +7,19 @@ import math
 import numpy as np
 import pytest
 from plugin_robots import STEREO_XACRO
-from sensor_fixtures import box, plugin_of, world_simulation
+from sensor_fixtures import box, expanded, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import Pose
 from mbot_sim_bridge.core.cameras.multicamera import MultiCamera
 from mbot_sim_bridge.core.description.robot_model import parse_robot
-from mbot_sim_bridge.robot_description import expand_xacro
 
 BASELINE, HEAD_HEIGHT, WIDTH, HFOV = 0.07, 1.0, 320, 1.047
 AT_ORIGIN = Pose((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
 def urdf():
-    return expand_xacro(STEREO_XACRO, width=str(WIDTH))
+    return expanded(STEREO_XACRO, width=str(WIDTH))
 
 
 def red_columns(rgb: np.ndarray) -> np.ndarray:

@@ -8,6 +8,7 @@ import pathlib
 
 import pytest
 from ros_control_fixtures import WORKSPACE_SRC, load_yaml, simulate
+from sensor_fixtures import expanded
 
 from mbot_sim_bridge.core.errors import ModelError, WorldError
 from mbot_sim_bridge.core.geometry import IDENTITY, Pose
@@ -15,7 +16,6 @@ from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
-from mbot_sim_bridge.robot_description import expand_xacro
 from mbot_sim_bridge.package_uris import resolve_package_uris
 
 HUSKY_SIZED_XACRO = os.path.join(WORKSPACE_SRC, "mobile_test_robots", "urdf", "husky_sized_base.urdf.xacro")
@@ -56,7 +56,7 @@ def world(tmp_path, *models, constraints=""):
 
 
 def husky_sized_base(sim, pose=IDENTITY):
-    urdf = expand_xacro(HUSKY_SIZED_XACRO)
+    urdf = expanded(HUSKY_SIZED_XACRO)
     return sim.spawn_robot(parse_robot(urdf, "model 'husky'"), "husky", pose)
 
 
@@ -100,7 +100,7 @@ def test_a_husky_sized_base_spawned_at_z_0_rises_onto_its_wheels_within_1_s_with
 
 
 def test_the_rover_spawned_at_z_0_as_its_launch_file_does_rises_onto_its_wheels_within_1_s_without_a_jump():
-    urdf = expand_xacro(ROVER_XACRO, lidar_3d_enabled="false")
+    urdf = expanded(ROVER_XACRO, lidar_3d_enabled="false")
     sim, _, _ = simulate(urdf, load_yaml(ROVER_CONTROL), "rover", package_uris=resolve_package_uris,
                          namespace="/")
     try:

@@ -4,18 +4,17 @@ import math
 
 import pytest
 from plugin_robots import HOLONOMIC_XACRO
-from sensor_fixtures import plugin_of, world_simulation
+from sensor_fixtures import expanded, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.geometry import Pose, pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.drives.planar_move import PlanarMove
 from mbot_sim_bridge.core.description.robot_model import parse_robot
-from mbot_sim_bridge.robot_description import expand_xacro
 
 
 @pytest.fixture
 def base(tmp_path):
     sim = world_simulation(tmp_path)
-    urdf = expand_xacro(HOLONOMIC_XACRO)
+    urdf = expanded(HOLONOMIC_XACRO)
     # On the ground: planar move zeroes the vertical velocity every step, so a base spawned above it takes
     # seconds to sink down (in Gazebo too).
     spawned = sim.spawn_robot(parse_robot(urdf, "model 'holonomic_base'"), "holonomic_base",

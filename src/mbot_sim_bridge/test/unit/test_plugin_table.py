@@ -1,6 +1,7 @@
 """The one plugin table: the ROS registry derived from it, both loaded per file name, no copy of the table
 elsewhere, added plugin blocks checked."""
 import ast
+import functools
 import importlib
 import os
 import pkgutil
@@ -54,6 +55,7 @@ def test_every_plugin_class_of_the_ros_package_is_reachable_through_the_registry
             assert in_use, f"{module.__name__}.{plugin_class.__name__}"
 
 
+@functools.lru_cache(maxsize=None)  # every parametrized case reads the same files: parsed once per run
 def _modules_imported_by_tests():
     """Test module -> the modules it imports (the checks of this file and of the README's tables left out)."""
     imported = {}

@@ -7,19 +7,18 @@ from xml.etree import ElementTree
 
 import pytest
 from plugin_robots import SKID_XACRO
-from sensor_fixtures import measured_motion, plugin_of, world_simulation
+from sensor_fixtures import expanded, measured_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.drives.skid_steer_drive import SkidSteerDrive
-from mbot_sim_bridge.robot_description import expand_xacro
 
 
 WHEELS = ("front_left", "front_right", "rear_left", "rear_right")
 
 
 def urdf():
-    return expand_xacro(SKID_XACRO)
+    return expanded(SKID_XACRO)
 
 
 def with_wheel_friction(text):

@@ -6,20 +6,19 @@ import math
 
 import pytest
 from plugin_robots import TRICYCLE_XACRO
-from sensor_fixtures import measured_motion, plugin_of, world_simulation
+from sensor_fixtures import expanded, measured_motion, plugin_of, world_simulation
 
 from mbot_sim_bridge.core.errors import ConfigError
 from mbot_sim_bridge.core.geometry import pose_from_xyz_rpy, yaw
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.drives.tricycle_drive import TricycleDrive
-from mbot_sim_bridge.robot_description import expand_xacro
 
 WHEELBASE = 0.5
 ON_ITS_WHEELS = pose_from_xyz_rpy((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 def urdf(odometry_source="world"):
-    return expand_xacro(TRICYCLE_XACRO, odometry_source=odometry_source)
+    return expanded(TRICYCLE_XACRO, odometry_source=odometry_source)
 
 
 def spawn(tmp_path, text):

@@ -10,14 +10,13 @@ from xml.etree import ElementTree
 import numpy as np
 import pytest
 from ros_control_fixtures import ROBOTS, WORKSPACE_SRC, load_yaml, simulate, start_controllers
-from sensor_fixtures import measured_motion
+from sensor_fixtures import expanded, measured_motion
 
 from mbot_sim_bridge.core.errors import ModelError
 from mbot_sim_bridge.core.geometry import rpy, yaw
 from mbot_sim_bridge.core.description.robot_model import parse_robot
 from mbot_sim_bridge.core.wheel_contact import _outside
 from mbot_sim_bridge.package_uris import resolve_package_uris
-from mbot_sim_bridge.robot_description import expand_xacro
 
 LONG = os.environ.get("MBOT_LONG_TESTS") == "1"
 CASTER_CONTROL = os.path.join(ROBOTS, "config", "caster_control.yaml")
@@ -26,7 +25,7 @@ HUSKY = {"wheel_radius": "0.1651", "wheel_width": "0.1143", "track": "0.5708", "
 
 
 def caster_base_urdf():
-    return expand_xacro(os.path.join(ROBOTS, "urdf", "caster_base.urdf.xacro"))
+    return expanded(os.path.join(ROBOTS, "urdf", "caster_base.urdf.xacro"))
 
 
 @pytest.fixture(scope="module")
@@ -78,14 +77,14 @@ def test_the_caster_base_tracks_within_5_percent_and_stays_level(caster_base, li
 
 # -- skid steering ---------------------------------------------------------------------------------------------
 def _rover():
-    urdf = expand_xacro(os.path.join(WORKSPACE_SRC, "rover_description", "urdf", "rover.urdf.xacro"),
+    urdf = expanded(os.path.join(WORKSPACE_SRC, "rover_description", "urdf", "rover.urdf.xacro"),
                         lidar_3d_enabled="false")
     controllers = load_yaml(os.path.join(WORKSPACE_SRC, "rover_control", "config", "control.yaml"))
     return urdf, controllers, "rover_velocity_controller", "rover_joint_publisher"
 
 
 def _husky_quad():
-    urdf = expand_xacro(os.path.join(ROBOTS, "urdf", "quad_base.urdf.xacro"), **HUSKY)
+    urdf = expanded(os.path.join(ROBOTS, "urdf", "quad_base.urdf.xacro"), **HUSKY)
     controllers = load_yaml(os.path.join(ROBOTS, "config", "quad_control.yaml"))
     assert controllers["quad_velocity_controller"]["wheel_separation_multiplier"] == 1.875
     return urdf, controllers, "quad_velocity_controller", "quad_joint_publisher"
