@@ -8,8 +8,9 @@ no joint position in a model, and Gazebo's ModelState writes links only); readin
 from those poses.
 Scene and the other non-model world elements are copied. Physics, gravity and lights are written as they
 are now: set_physics_properties' settings, and each light as read unless set_light_properties changed it (then
-a ``<light>`` with its values now, the sun's include too) or delete_light removed it. Robots spawned from URDF are left out unless asked for; then each becomes an inline model
-converted the way Gazebo's URDF import does, at its links' current poses, with its plugins kept as tags.
+a ``<light>`` with its values now, the sun's include too) or delete_light removed it. Robots spawned from URDF
+are left out unless asked for; then each becomes an inline model converted the way Gazebo's URDF import does, at
+its links' current poses, with its plugins kept as tags.
 Model poses are written as world poses, so world ``<frame>``s are not needed and not written. The file is
 SDF 1.6, or 1.7 when a model written back uses 1.7's ``relative_to``/``attached_to`` frames.
 """
