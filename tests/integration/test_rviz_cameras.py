@@ -15,8 +15,9 @@ import yaml
 from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS
-from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, colour_count, keep_screenshot, parse_colour, scenes,
-                       screen, start_rviz, view_3d, watch)  # noqa: F401 (scenes and screen: fixtures)
+from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, colour_count, keep_screenshot, parse_colour, start_rviz,
+                       view_3d, watch)
+from test_rviz import scenes, screen  # noqa: F401 (fixtures: the tests name them)
 
 CONFIG_DIR = os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config")
 SKY = np.array((178, 178, 178))
@@ -49,7 +50,7 @@ def test_these_are_the_configs_test_rviz_leaves_out():
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_rviz_shows_the_camera_picture(case, scenes, screen, tmp_path):
+def test_rviz_shows_the_camera_picture(case, scenes, screen, tmp_path):  # noqa: F811 (test_rviz's fixtures)
     launch_file, config_name, topics = CASES[case]
     config = os.path.join(CONFIG_DIR, config_name)
     with open(config) as stream:

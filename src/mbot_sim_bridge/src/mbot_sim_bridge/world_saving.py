@@ -21,7 +21,8 @@ PLUGINS_AS_TAGS = ("robots are written as inline SDF models; their plugins are k
 class SaveWorldHandler:
     """The ``~save_world`` handler: ``rospy.Service("~save_world", SaveWorld, SaveWorldHandler(world, sim,
     node.call_in_loop))``. ``world`` is the description the simulation was loaded from (its name, scene and
-    other elements are written back; lights and physics as they are now); ``simulation`` a core Simulation, read only through ``call_in_loop``."""
+    other elements are written back; lights and physics as they are now); ``simulation`` a core Simulation, read
+    only through ``call_in_loop``."""
 
     def __init__(self, world: WorldDescription, simulation, call_in_loop: Callable):
         self.world = world
