@@ -14,7 +14,9 @@ from xml.etree import ElementTree
 
 from .spec import Check, Run
 
-METRIC_LINE = re.compile(r"^metric (\S+) (\S+)\s*$", re.MULTILINE)
+# A rostest scenario's metrics may follow unittest's verbose "test_name (module.Case) ... " on its line, which it
+# ends only with the test's outcome.
+METRIC_LINE = re.compile(r"^(?:test\S* \(\S+\) \.\.\. )?metric (\S+) (\S+)\s*$", re.MULTILINE)
 PASSED, FAILED, ERROR, TIMEOUT = "passed", "failed", "error", "timeout"
 # A run that crashed, hung or whose worker died is retried as the spec says; a verdict from its checks is final.
 RETRIED = (ERROR, TIMEOUT)

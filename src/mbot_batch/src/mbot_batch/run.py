@@ -222,18 +222,24 @@ def end_with_parent_or_signal(token: str, parent: int, folder: str):
     """Kill the run and end this process at once on SIGINT/SIGTERM or when ``parent``, the process that started
     it, dies (a worker killed, a driver gone), whatever this process is doing: starting the master, waiting,
     stopping. The parent's pid comes from the parent: one that died while this process was still importing
-    would otherwise go unnoticed. Without its parent, nobody will read the run's folder: it goes too."""
+    would otherwise go unnoticed. Without its parent, nobody will read the run's folder: it goes too.
+
+    The end is always the signal handler's, in the main thread, the one that starts the run's processes: a watch
+    thread that killed them itself could miss one the main thread started after its last scan (an orphaned
+    master and launch were seen so)."""
+    parent_gone = threading.Event()
 
     def end(*_):
         kill_token(token, exclude=(os.getpid(),))
+        if parent_gone.is_set():
+            shutil.rmtree(folder, ignore_errors=True)
         os._exit(1)
 
     def watch():
         while os.getppid() == parent:
             time.sleep(POLL_SECONDS)
-        kill_token(token, exclude=(os.getpid(),))
-        shutil.rmtree(folder, ignore_errors=True)
-        os._exit(1)
+        parent_gone.set()
+        os.kill(os.getpid(), signal.SIGTERM)
     signal.signal(signal.SIGINT, end)
     signal.signal(signal.SIGTERM, end)
     threading.Thread(target=watch, name="parent watch", daemon=True).start()

@@ -28,6 +28,12 @@ def test_metrics_are_read_exactly_from_the_scenario_output():
     assert metrics["distance"].hex() == (value * 2).hex()
 
 
+def test_a_rostest_scenarios_first_metric_is_read_after_unittests_test_name():
+    text = ("test_the_mbot_moves_forward (__main__.Drive.test_the_mbot_moves_forward) ... metric x 0.25\n"
+            "metric y -2e-07\nok\nnot a metric x 1\n")
+    assert results.parse_metrics(text) == {"x": 0.25, "y": -2e-07}
+
+
 def test_verdicts():
     assert results.verdict(raw(metrics={"distance": 2.0}), CHECKS)["status"] == "passed"
     failed = results.verdict(raw(metrics={"distance": 0.5}), CHECKS)
