@@ -3,6 +3,7 @@ would launch the world again): each is called through ROS
 once with good values and once with each kind of bad value, on a turntable spawned beside the mbot; the answer
 is success or upstream's message, and the mbot, a bystander, does not move."""
 import math
+import os
 import unittest
 
 import rospy
@@ -17,18 +18,8 @@ from std_msgs.msg import ColorRGBA
 
 from sim_support import Simulator, print_figures, wait_for
 
-TURNTABLE = """<robot name="table">
-  <link name="base_link">
-    <inertial><mass value="50"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.1"/><geometry><box size="0.6 0.6 0.2"/></geometry></collision>
-  </link>
-  <link name="plate">
-    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.02"/></geometry></collision>
-  </link>
-  <joint name="turntable" type="continuous"><parent link="base_link"/><child link="plate"/>
-    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/></joint>
-</robot>"""
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "urdf", "turntable.urdf")) as turntable:
+    TURNTABLE = turntable.read()
 PLATE = "table::plate"
 
 

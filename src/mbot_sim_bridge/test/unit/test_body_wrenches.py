@@ -3,6 +3,7 @@ libgazebo_ros_f3d.so (core/sensors/f3d.py): a crate held up by its weight's wort
 wrench ends or is cleared; f3d reports the applied force on its link and nothing without one; a reference point
 and a reference frame change the wrench as upstream's transform does; bad requests are refused."""
 import math
+import os
 
 import pytest
 from sensor_fixtures import plugin_of, world_simulation
@@ -18,22 +19,12 @@ CRATE = f"""<model name="crate"><pose>0 0 1 0 0 0</pose><link name="link">
   <inertial><mass>{CRATE_MASS}</mass><inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz></inertia></inertial>
   <collision name="c"><geometry><box><size>0.3 0.3 0.3</size></box></geometry></collision>
 </link></model>"""
-# A base with a plate on a revolute joint; f3d on the plate.
-ARM = """<robot name="arm">
-  <link name="base_link">
-    <inertial><mass value="50"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><origin xyz="0 0 0.1"/><geometry><box size="0.6 0.6 0.2"/></geometry></collision>
-  </link>
-  <link name="plate">
-    <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.02"/></geometry></collision>
-  </link>
-  <joint name="turntable" type="revolute"><parent link="base_link"/><child link="plate"/>
-    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
-  <gazebo><plugin name="f3d" filename="libgazebo_ros_f3d.so">
+# The service tests' turntable (a base with a plate on a joint), with f3d on the plate.
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "..", "tests", "urdf",
+                       "turntable.urdf")) as turntable:
+    ARM = turntable.read().replace("</robot>", """<gazebo><plugin name="f3d" filename="libgazebo_ros_f3d.so">
     <bodyName>{body}</bodyName><topicName>plate_wrench</topicName><frameName>plate</frameName>
-  </plugin></gazebo>
-</robot>"""
+  </plugin></gazebo></robot>""")
 
 
 def crate_height(sim):
