@@ -1,10 +1,11 @@
-"""./mbot batch end to end, on 4 short runs (the mbot drives for a second of sim time in the empty world, at two
-speeds, as a Python scenario and as a rostest file):
+"""./mbot batch end to end, on 12 short runs (two seeds and two speeds: the mbot drives for a second of sim time
+in the empty world as a Python scenario and as a rostest file, and a box slides in the simulator alone):
 
 - the embedded default: the driver killed (SIGKILL) after two runs, then Ctrl-C'd, then run to the end, each
   time resuming and skipping finished runs; no process of a run is left after a kill or a Ctrl-C;
 - a real two-node cluster (``dask scheduler`` and two ``dask worker`` processes, each in its own process group),
-  one worker killed while it runs a run: the run is rescheduled and every result equals the embedded one;
+  one worker killed while it runs a run: the run is rescheduled and each of the 12 results equals the embedded
+  one;
 - a hanging run killed at its timeout, retried, reported with its log tail;
 - the rostest scenario's runs of that batch: their test cases' verdict and their metrics;
 - a failing run rerun with ``mbot batch rerun``: its metrics come out bit-identical;
@@ -29,7 +30,7 @@ pytestmark = pytest.mark.long
 HERE = os.path.dirname(os.path.abspath(__file__))
 BATCH = os.path.join(HERE, os.pardir, "scripts", "mbot_batch")
 SPEC = os.path.join(HERE, "scenarios", "drive.yaml")
-RUNS = 4
+RUNS = 12
 BATCH_TIMEOUT = 240
 CTRL_C_SECONDS = 5.0
 
@@ -72,6 +73,16 @@ def assert_no_run_processes(out, timeout=3.0):
                interval=SCAN_INTERVAL)
 
 
+def scheduling_policies(pids):
+    policies = set()
+    for pid in pids:
+        try:
+            policies.add(os.sched_getscheduler(pid))
+        except OSError:
+            continue  # ended meanwhile
+    return policies
+
+
 def stop_group(process):
     try:
         os.killpg(process.pid, signal.SIGKILL)
@@ -82,7 +93,7 @@ def stop_group(process):
 
 @pytest.fixture(scope="module")
 def embedded(tmp_path_factory):
-    """The 4 runs on the embedded default, interrupted twice on the way (one worker until then: each worker
+    """The 12 runs on the embedded default, interrupted twice on the way (one worker until then: each worker
     process costs its start-up again); what each interruption left."""
     out = str(tmp_path_factory.mktemp("embedded") / "out")
     seen = {}
@@ -95,8 +106,10 @@ def embedded(tmp_path_factory):
         seen["after kill"] = result_files(out)
 
         driver = start_batch(out, "--workers", "1")
-        wait_until(lambda: processes_with_token(batch_token(out)), 60, "a resumed run to be running",
+        # The run process and a process it started (after it set its policy, which they inherit).
+        wait_until(lambda: len(processes_with_token(batch_token(out))) >= 2, 60, "a resumed run to be running",
                    interval=SCAN_INTERVAL)
+        seen["policies"] = scheduling_policies(processes_with_token(batch_token(out)))
         interrupted = time.monotonic()
         os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the driver and its workers
         seen["ctrl-c exit"] = driver.wait(timeout=30)
@@ -119,6 +132,7 @@ def test_a_killed_or_interrupted_driver_resumes_and_skips_finished_runs(embedded
     final = result_files(out)
     for stage in ("after kill", "after ctrl-c"):
         assert {run_id: final[run_id] for run_id in seen[stage]} == seen[stage], f"a run finished {stage} ran again"
+    assert seen["policies"] == {os.SCHED_BATCH}, "a run's processes are batch tasks"
     assert seen["ctrl-c exit"] == 130
     print(f"figure: batch: Ctrl-C to the driver's exit {seen['ctrl-c seconds']:.1f} s, no run process left")
     assert seen["ctrl-c seconds"] < CTRL_C_SECONDS
@@ -185,7 +199,7 @@ def test_a_two_node_cluster_gives_the_embedded_results_and_reschedules_a_killed_
     finally:
         stop_group(driver)
     assert driver.returncode == 1
-    assert finished(out) == finished(reference)
+    assert len(finished(out)) == RUNS and finished(out) == finished(reference)
     rescheduled = load_result(out, killed_run)
     print(f"figure: batch: {killed_run}, its worker killed, finished on {rescheduled['worker']}")
     assert rescheduled["attempts"] == 1 and rescheduled["status"] == load_result(reference, killed_run)["status"]
@@ -231,7 +245,7 @@ def test_a_rostest_scenario_counts_its_test_cases_and_metrics(embedded):
     results = [load_result(out, run_id) for run_id in finished(out)]
     verdicts = sorted((result["metrics"]["x"] > 0.05, result["status"], result["reason"])
                       for result in results if result["scenario"] == "drive_test")
-    assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed"), (True, "passed", "")]
+    assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed")] * 2 + [(True, "passed", "")] * 2
 
 
 def test_rerunning_a_failing_run_reproduces_its_metrics_bit_identically(embedded):

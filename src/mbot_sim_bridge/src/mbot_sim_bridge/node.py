@@ -18,6 +18,7 @@ import rospy
 import rospy.impl.simtime
 from rosgraph_msgs.msg import Clock
 
+from .core.added_plugins import ADDED_JOINT_STATE_RATE
 from .core.clock import UpdateTimer
 from .core.errors import BridgeError, WorldError
 from .gazebo_paths import model_path
@@ -67,7 +68,7 @@ class SimBridgeNode:
         # Gazebo publishes /clock on every step; from Python that costs more than the step itself, so the
         # bridge defaults to 100 Hz and also publishes right before any plugin output (see README).
         clock_frequency = float(rospy.get_param("~pub_clock_frequency", DEFAULT_CLOCK_FREQUENCY))
-        joint_state_rate = float(rospy.get_param("~joint_state_rate", 100.0))
+        joint_state_rate = float(rospy.get_param("~joint_state_rate", ADDED_JOINT_STATE_RATE))
         seed = int(rospy.get_param("~seed", 0))
 
         world = parse_world(self.world_path, model_path())

@@ -14,6 +14,10 @@ from .plugin import Plugin
 from .plugin_table import filename_of
 
 JOINT_STATE_PLUGIN = filename_of(JointStatePublisher)
+# Hz of sim time for the joints no plugin publishes (casters, passive joints): joint_state_publisher's default rate,
+# at which the course's Gazebo launch files published them. robot_state_publisher asks the master for tf_prefix
+# three times per transform set it sends, so at 100 Hz this second stream cost the master a quarter of its calls.
+ADDED_JOINT_STATE_RATE = 10.0
 MIMIC_PLUGIN = filename_of(MimicJoint)
 
 

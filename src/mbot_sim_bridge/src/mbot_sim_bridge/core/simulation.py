@@ -15,7 +15,7 @@ from xml.etree import ElementTree
 import numpy as np
 import pybullet
 
-from .added_plugins import joint_state_blocks, mimic_blocks
+from .added_plugins import ADDED_JOINT_STATE_RATE, joint_state_blocks, mimic_blocks
 from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
 from .engine import Engine, StepFault, check_state, frame_velocity
 from .errors import ConfigError, ModelError
@@ -57,7 +57,7 @@ BeforeUpdates = Callable[[float, bool], None]
 
 class Simulation:
     def __init__(self, world: WorldDescription, registry: Mapping[str, type], seed: int = 0,
-                 connection_mode: int = pybullet.DIRECT, joint_state_rate: float = 100.0,
+                 connection_mode: int = pybullet.DIRECT, joint_state_rate: float = ADDED_JOINT_STATE_RATE,
                  parameters: Optional[Parameters] = None, package_uris: Callable[[str], str] = str):
         """``parameters``: what plugins read from the parameter server (gazebo_ros_control, tf_prefix);
         ``package_uris``: resolves package:// in a robot description read from there, as spawning does."""
