@@ -77,7 +77,7 @@ def test_rviz_shows_the_camera_picture(case, scenes, screen, tmp_path):  # noqa:
     keep_screenshot(screenshot)
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     view = view_3d(image, background)
-    assert view is not None, "no 3D view " + where
+    assert view is not None, f"no 3D view (rviz's exit status: {rviz.poll()}) " + where
     sky, robot = sky_pixels(image), colour_count(view, robot_colour)
     cloud = cloud_pixels(view)
     print(f"figure: rviz {case}: {sky} picture-sky pixels, {robot} robot pixels, {cloud} cloud pixels in the 3D view")
