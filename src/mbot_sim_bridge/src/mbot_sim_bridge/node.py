@@ -4,6 +4,7 @@ Everything that touches the engine runs in the loop's thread; ROS callbacks (ser
 work or values over. The loop paces itself with time.monotonic() to follow the real-time factor: it must not
 use rospy.Rate or rospy.sleep, because under use_sim_time those wait for the /clock this loop publishes.
 """
+import math
 import os
 import queue
 import sys
@@ -53,6 +54,19 @@ def _bool_param(name: str, default: bool) -> bool:
         raise BridgeError(f"parameter {rospy.resolve_name(name)}: {error}, got '{value}'") from None
 
 
+def _rate_param(name: str, default: float) -> float:
+    """A rate in Hz of sim time (≤ 0: every step): a finite number, else the node stops naming the parameter (a
+    NaN here used to reach every robot's spawn as a bad <updateRate> of a plugin the user never wrote)."""
+    value = rospy.get_param(name, default)
+    try:
+        rate = float(value)
+    except (TypeError, ValueError):
+        rate = math.nan
+    if isinstance(value, bool) or not math.isfinite(rate):
+        raise BridgeError(f"parameter {rospy.resolve_name(name)}: not a finite rate in Hz, got '{value}'")
+    return rate
+
+
 class SimBridgeNode:
     def __init__(self):
         # First: the writer process starts while the world loads, and every loop publisher writes through it.
@@ -67,8 +81,8 @@ class SimBridgeNode:
         real_time_factor = str(rospy.get_param("~real_time_factor", "")).strip()
         # Gazebo publishes /clock on every step; from Python that costs more than the step itself, so the
         # bridge defaults to 100 Hz and also publishes right before any plugin output (see README).
-        clock_frequency = float(rospy.get_param("~pub_clock_frequency", DEFAULT_CLOCK_FREQUENCY))
-        joint_state_rate = float(rospy.get_param("~joint_state_rate", ADDED_JOINT_STATE_RATE))
+        clock_frequency = _rate_param("~pub_clock_frequency", DEFAULT_CLOCK_FREQUENCY)
+        joint_state_rate = _rate_param("~joint_state_rate", ADDED_JOINT_STATE_RATE)
         seed = int(rospy.get_param("~seed", 0))
 
         world = parse_world(self.world_path, model_path())
