@@ -8,6 +8,7 @@ The checks look at the 3D view of a screenshot: the colour of the robot's base f
 the LaserScan display's flat colour from the config. MBOT_SCREENSHOT_DIR, if set, receives a copy of each
 screenshot.
 """
+import contextlib
 import glob
 import os
 import re
@@ -40,7 +41,8 @@ DRAW_TIMEOUT = 30.0
 STEADY = 3.0
 # Each screenshot is an xwd, a PNG and its analysis: taken back to back they were a tenth of a test's CPU.
 SCREENSHOT_PERIOD = 0.5
-RVIZ_ATTEMPTS = 2
+RVIZ_STARTS = 2
+REGISTER_TIMEOUT = 60  # seconds for rviz to register with the master, on a loaded machine
 # Seconds between the tests' questions to the master: each getSystemState is an XML-RPC call rosmaster answers in
 # Python, and asked every 20 ms while a simulation starts they were a tenth of a test's CPU.
 MASTER_POLL = 0.25
@@ -132,22 +134,9 @@ def test_rviz_shows_the_robot(config, scenes, screen, tmp_path):
     screenshot = tmp_path / ("rviz_" + os.path.basename(config).replace(".rviz", ".png"))
     # HOME: rviz writes ~/.rviz/persistent_settings, which a test must not touch.
     environment = screen.environment(ros_env, HOME=str(tmp_path))
-    for attempt in range(1, RVIZ_ATTEMPTS + 1):
-        log_path = tmp_path / (f"rviz-{attempt}.log")
-        rviz = start_rviz(config, environment, log_path, master, 30)
-        try:
-            image = watch(screen, screenshot, lambda image: rviz.poll() is not None or drawn(image),
-                          DRAW_TIMEOUT, STEADY)
-            crashed = rviz.poll() is not None
-        finally:
-            stop_process_group(rviz)
-        if not crashed:
-            break
-        # rviz 1.14 sometimes aborts in OGRE's start-up under software OpenGL (std::bad_alloc); that is
-        # rviz's own failure, not the configuration's, so it gets one more start before the test fails.
-        print(f"rviz exited with {rviz.returncode} on start {attempt}:\n{log_path.read_text()}")
-    assert not crashed, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
-    keep_screenshot(screenshot)
+    with running_rviz(config, environment, master, screen, screenshot, drawn, DRAW_TIMEOUT,
+                      STEADY) as (_, image, log_path):
+        keep_screenshot(screenshot)
 
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50, "the screen is blank " + where
@@ -228,6 +217,33 @@ def start_rviz(config, environment, log_path, master, timeout):
         stop_process_group(rviz)
         raise
     return rviz
+
+
+@contextlib.contextmanager
+def running_rviz(config, environment, master, screen, screenshot, condition, timeout, steady):
+    """``with running_rviz(...) as (_, image, log_path):`` rviz on ``config``, watched (see ``watch``) until
+    ``condition(image)`` has held ``steady`` seconds or ``timeout`` has passed, and running until the block ends;
+    its output is in ``log_path``, beside ``screenshot``.
+
+    rviz 1.14 now and then exits by itself under software OpenGL while the suite loads the machine: an abort in
+    OGRE's start-up (std::bad_alloc, exit status -6), about once in a few dozen suite starts, none in 45 starts of
+    the kinect config beside its simulation alone. That is rviz's own failure, not what these tests check, so such
+    an rviz is started once more, its output printed, before the test fails.
+    """
+    for start in range(1, RVIZ_STARTS + 1):
+        log_path = screenshot.parent / f"rviz-{start}.log"
+        rviz = start_rviz(config, environment, log_path, master, REGISTER_TIMEOUT)
+        try:
+            image = watch(screen, screenshot, lambda image: rviz.poll() is not None or condition(image), timeout,
+                          steady)
+            if rviz.poll() is None:
+                yield rviz, image, log_path
+                return
+        finally:
+            stop_process_group(rviz)
+        print(f"rviz exited with {rviz.returncode} on start {start}:\n{log_path.read_text()}")
+    pytest.fail(f"rviz exited with {rviz.returncode} on each of {RVIZ_STARTS} starts (output {log_path}):\n"
+                + "\n".join(log_path.read_text().splitlines()[-20:]))
 
 
 def keep_screenshot(path):

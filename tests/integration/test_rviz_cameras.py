@@ -12,11 +12,10 @@ import os
 import numpy as np
 import pytest
 import yaml
-from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS
-from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, colour_count, keep_screenshot, parse_colour, start_rviz,
-                       view_3d, watch)
+from test_rviz import (CAMERA_CONFIGS, assert_no_tf_errors, colour_count, keep_screenshot, parse_colour, running_rviz,
+                       view_3d)
 from test_rviz import scenes, screen  # noqa: F401 (fixtures: the tests name them)
 
 CONFIG_DIR = os.path.join(os.path.dirname(TESTS), "src", "mbot_description", "config")
@@ -66,18 +65,13 @@ def test_rviz_shows_the_camera_picture(case, scenes, screen, tmp_path):  # noqa:
                 and (case != "kinect" or cloud_pixels(view) >= MIN_CLOUD_PIXELS))
 
     screenshot = tmp_path / ("rviz_" + config_name.replace(".rviz", ".png"))
-    log_path = tmp_path / "rviz.log"
     environment = screen.environment(ros_env, HOME=str(tmp_path))
-    rviz = start_rviz(config, environment, log_path, master, 60)
-    try:
-        # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
-        image = watch(screen, screenshot, lambda image: rviz.poll() is not None or drawn(image), 120, 2.0)
-    finally:
-        stop_process_group(rviz)
-    keep_screenshot(screenshot)
+    # The picture arrives slowly on a loaded machine: a 1280x720 frame is rendered on the CPU.
+    with running_rviz(config, environment, master, screen, screenshot, drawn, 120, 2.0) as (_, image, log_path):
+        keep_screenshot(screenshot)
     where = f"(screenshot {screenshot}, rviz output {log_path})"
     view = view_3d(image, background)
-    assert view is not None, f"no 3D view (rviz's exit status: {rviz.poll()}) " + where
+    assert view is not None, "no 3D view " + where
     sky, robot = sky_pixels(image), colour_count(view, robot_colour)
     cloud = cloud_pixels(view)
     print(f"figure: rviz {case}: {sky} picture-sky pixels, {robot} robot pixels, {cloud} cloud pixels in the 3D view")

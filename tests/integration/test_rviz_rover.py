@@ -14,7 +14,7 @@ from mbot_sim_bridge.processes import stop_process_group
 
 from ros_processes import TESTS, wait_until
 from test_rviz import (DRAW_TIMEOUT, MASTER_POLL, MIN_ROBOT_PIXELS, assert_no_tf_errors, base_link_colour,
-                       colour_mask, parse_colour, published, start_rviz, view_3d, watch)
+                       colour_mask, parse_colour, published, running_rviz, view_3d, watch)
 from xvfb import Xvfb
 
 pytestmark = pytest.mark.long
@@ -47,12 +47,9 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
     shots = [tmp_path / "rviz_rover_at_rest.png", tmp_path / "rviz_rover_driven.png"]
     with Xvfb(tmp_path / "xvfb.log") as server:
         environment = server.environment(ros_env, HOME=str(tmp_path))
-        log_path = tmp_path / "rviz.log"
-        rviz = start_rviz(CONFIG, environment, log_path, master, 30)
-        driver = None
-        try:
-            image = watch(server, shots[0], lambda image: robot_centre(image, background, colour) is not None,
-                          DRAW_TIMEOUT, STEADY)
+        with running_rviz(CONFIG, environment, master, server, shots[0],
+                          lambda image: robot_centre(image, background, colour) is not None, DRAW_TIMEOUT,
+                          STEADY) as (rviz, image, log_path):
             start = robot_centre(image, background, colour)
             assert start is not None, f"the rover is not drawn at rest (screenshot {shots[0]}, rviz {log_path})"
             # As the README says: rostopic pub at 10 Hz on /cmd_vel, twist_mux's lowest-priority input.
@@ -60,16 +57,14 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
                 driver = subprocess.Popen(["rostopic", "pub", "-r", "10", "/cmd_vel", "geometry_msgs/Twist",
                                            "{linear: {x: 0.5}}"], env=ros_env, stdout=log,
                                           stderr=subprocess.STDOUT, start_new_session=True)
-
-            def moved(image):
-                centre = robot_centre(image, background, colour)
-                return centre is not None and np.linalg.norm(centre - start) >= MIN_SHIFT_PIXELS
-            image = watch(server, shots[1], moved, DRAW_TIMEOUT, STEADY)
-            assert rviz.poll() is None, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
-        finally:
-            if driver is not None:
+            try:
+                def moved(image):
+                    centre = robot_centre(image, background, colour)
+                    return centre is not None and np.linalg.norm(centre - start) >= MIN_SHIFT_PIXELS
+                image = watch(server, shots[1], moved, DRAW_TIMEOUT, STEADY)
+            finally:
                 stop_process_group(driver)
-            stop_process_group(rviz)
+            assert rviz.poll() is None, f"rviz exited with {rviz.returncode}:\n{log_path.read_text()}"
     if os.environ.get("MBOT_SCREENSHOT_DIR"):
         os.makedirs(os.environ["MBOT_SCREENSHOT_DIR"], exist_ok=True)
         for shot in shots:
