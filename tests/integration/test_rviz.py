@@ -221,14 +221,14 @@ def start_rviz(config, environment, log_path, master, timeout):
 
 @contextlib.contextmanager
 def running_rviz(config, environment, master, screen, screenshot, condition, timeout, steady):
-    """``with running_rviz(...) as (_, image, log_path):`` rviz on ``config``, watched (see ``watch``) until
+    """``with running_rviz(...) as (rviz, image, log_path):`` rviz on ``config``, watched (see ``watch``) until
     ``condition(image)`` has held ``steady`` seconds or ``timeout`` has passed, and running until the block ends;
     its output is in ``log_path``, beside ``screenshot``.
 
     rviz 1.14 now and then exits by itself under software OpenGL while the suite loads the machine: an abort in
     OGRE's start-up (std::bad_alloc, exit status -6), about once in a few dozen suite starts, none in 45 starts of
-    the kinect config beside its simulation alone. That is rviz's own failure, not what these tests check, so such
-    an rviz is started once more, its output printed, before the test fails.
+    the kinect config outside the suite. That is rviz's own failure, not what these tests check, so such
+    an rviz is started once more, its exit a figure and its output printed, before the test fails.
     """
     for start in range(1, RVIZ_STARTS + 1):
         log_path = screenshot.parent / f"rviz-{start}.log"
@@ -241,7 +241,9 @@ def running_rviz(config, environment, master, screen, screenshot, condition, tim
                 return
         finally:
             stop_process_group(rviz)
-        print(f"rviz exited with {rviz.returncode} on start {start}:\n{log_path.read_text()}")
+        # A figure line, so that a run's summary shows how often rviz needed its second start.
+        print(f"figure: rviz on {os.path.basename(config)} exited with {rviz.returncode} on start {start} of "
+              f"{RVIZ_STARTS}; its output:\n{log_path.read_text()}")
     pytest.fail(f"rviz exited with {rviz.returncode} on each of {RVIZ_STARTS} starts (output {log_path}):\n"
                 + "\n".join(log_path.read_text().splitlines()[-20:]))
 
