@@ -57,10 +57,11 @@ def test_rviz_shows_the_rover_driven_by_cmd_vel(ros_env, launch, tmp_path):
                 driver = subprocess.Popen(["rostopic", "pub", "-r", "10", "/cmd_vel", "geometry_msgs/Twist",
                                            "{linear: {x: 0.5}}"], env=ros_env, stdout=log,
                                           stderr=subprocess.STDOUT, start_new_session=True)
+
+            def moved(image):
+                centre = robot_centre(image, background, colour)
+                return centre is not None and np.linalg.norm(centre - start) >= MIN_SHIFT_PIXELS
             try:
-                def moved(image):
-                    centre = robot_centre(image, background, colour)
-                    return centre is not None and np.linalg.norm(centre - start) >= MIN_SHIFT_PIXELS
                 image = watch(server, shots[1], moved, DRAW_TIMEOUT, STEADY)
             finally:
                 stop_process_group(driver)
