@@ -112,7 +112,7 @@ class ArmInitialJoints(unittest.TestCase):
         # Spawned hanging at rest, then set to 0.5 while spawn_model held the physics paused: the pendulum swings
         # with that amplitude (undamped; bob 0.2 kg 0.3 m below the hinge), whatever the moment of this reading.
         angle, rate = hinge.position[0], hinge.rate[0]
-        amplitude = math.acos(math.cos(angle) - PENDULUM_INERTIA * rate ** 2 / (2 * 0.2 * 9.8 * 0.3))
+        amplitude = math.acos(math.cos(angle) - PENDULUM_INERTIA * rate ** 2 / (2 * BOB_MASS * GRAVITY * BOB_DEPTH))
         self.assertAlmostEqual(amplitude, 0.5, delta=0.02)
         lines = [line for line in run.stderr.splitlines() if "no_such_joint" in line]
         self.assertEqual(len(lines), 1, run.stderr)
@@ -164,7 +164,8 @@ class ArmInitialJoints(unittest.TestCase):
                 dict(zip(state.joint_names, state.actual.positions)))
 
 
-PENDULUM_INERTIA = 0.001 + 0.2 * 0.3 ** 2  # about the hinge: the bob's own and its mass at 0.3 m
+BOB_MASS, BOB_DEPTH, GRAVITY = 0.2, 0.3, 9.8  # PENDULUM_URDF's bob, its depth below the hinge; the pick world's g
+PENDULUM_INERTIA = 0.001 + BOB_MASS * BOB_DEPTH ** 2  # about the hinge: the bob's own and its mass at its depth
 PENDULUM_URDF = """<robot name="pendulum">
   <link name="world"/>
   <joint name="anchor" type="fixed"><parent link="world"/><child link="base"/><origin xyz="0 0 1"/></joint>
