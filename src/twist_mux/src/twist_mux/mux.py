@@ -107,8 +107,8 @@ def check_topics(inputs: Sequence[Handle], locks: Sequence[Handle], output: str,
                  ) -> Tuple[List[Handle], List[Handle], List[str]]:
     """The inputs and locks to subscribe, and one error line per input left out: an input on ``output`` (the
     resolved cmd_vel_out) would feed itself, each message passing out and in again as fast as the node runs; an
-    input on a lock's topic cannot be told from it (one topic, one type; rospy would hand the lock the Twists and
-    upstream's roscpp refuses the second subscription and ends), and the input goes so that a lock is never lost.
+    input on a lock's topic cannot be told from it (one topic, one type; rospy would hand the lock the Twists, and
+    upstream's roscpp throws at the second subscription, uncaught), and the input goes so that a lock is never lost.
     Topics compare as ``resolve`` (rospy.resolve_name: namespace and remappings) gives them."""
     lock_of_topic = {}
     for lock in locks:

@@ -161,8 +161,8 @@ def test_an_input_on_the_output_topic_is_left_out_it_would_feed_itself():
 
 def test_a_lock_on_an_inputs_topic_leaves_the_input_out_with_one_line_naming_both():
     """A topic carries one type: a Bool lock and a Twist input cannot share it (rospy hands one subscriber the
-    other's messages; upstream's roscpp refuses the second subscription and the node ends). The input goes: a
-    configuration mistake never drops a lock."""
+    other's messages; upstream's roscpp throws at the second subscription, uncaught, and the node ends). The
+    input goes: a configuration mistake never drops a lock."""
     inputs, _ = parse_handles("velocity", [{"name": "joy", "topic": "joy_vel", "timeout": 0.5, "priority": 10},
                                            {"name": "nav", "topic": "nav_vel", "timeout": 0.5, "priority": 5}],
                               "~topics")
