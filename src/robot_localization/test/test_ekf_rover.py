@@ -176,6 +176,25 @@ class EkfRover(unittest.TestCase):
             said = [line for line in lines if line.startswith(topic + ":")]
             self.assertEqual(len(said), 1, f"{topic}: {lines}")
 
+    def test_05_odometry_stamped_far_ahead_is_said_once_and_the_node_keeps_publishing(self):
+        """Upstream queues such data and stops predicting until the clock reaches it (100 s here)."""
+        odometry = rospy.Publisher("/bad/odom", Odometry, queue_size=10)
+        wait_for(lambda: odometry.get_num_connections(), what="the second node to subscribe")
+        for _ in range(20):
+            odom = Odometry()
+            odom.header.stamp = rospy.Time.now() + rospy.Duration(100.0)
+            odom.header.frame_id, odom.child_frame_id = "bad_odom", "bad_base_link"
+            odom.pose.pose.orientation.w = 1.0
+            odom.twist.covariance = [0.01 if i % 7 == 0 else 0.0 for i in range(36)]
+            odometry.publish(odom)
+            rospy.rostime.wallsleep(0.05)
+        count = self.bad_filtered.count
+        wait_for(lambda: self.bad_filtered.count > count + 5, what="the second node to keep publishing")
+        self.assertLess(abs((rospy.Time.now() - self.bad_filtered.message.header.stamp).to_sec()), 1.0)
+        lines = [log.msg for log in self.logs if log.name == "/bad/ekf_bad_input" and "s ahead" in log.msg]
+        self.assertEqual(len(lines), 1, lines)
+        self.assertIn("odom0 (/bad/odom)", lines[0])
+
 
 if __name__ == "__main__":
     rostest.rosrun("robot_localization", "ekf_rover", EkfRover)

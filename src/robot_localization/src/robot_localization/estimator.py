@@ -18,6 +18,11 @@ from .geometry import Transform, block_rotation, cross, matrix_rpy, quaternion_m
 TWO_D_MEMBERS = [Z, ROLL, PITCH, VZ, VROLL, VPITCH, AZ]
 TWO_D_VARIANCE = 1e-6
 SET_POSE_VARIANCE = 1e-6
+# How far (s) a message's stamp may be ahead of the node's clock. Upstream has no bound: data from the future
+# waits in its queue, and while the queue holds any it does not predict, so a stamp 100 s ahead silences the
+# output for 100 s, and the input's older data is refused meanwhile. Beyond this the message is refused, said
+# once per input; within it (a sender's clock a little ahead, /clock arriving after the data) it waits.
+FUTURE_LIMIT = 1.0
 
 
 @dataclass
@@ -83,8 +88,10 @@ def six_by_six(block, offset):
 
 
 class Estimator:
-    def __init__(self, lookup, warn, frames=None, two_d_mode=False, gravity=9.80665, predict_to_current_time=False):
+    def __init__(self, lookup, warn, frames=None, two_d_mode=False, gravity=9.80665, predict_to_current_time=False,
+                 topics=None):
         self.lookup, self.warn = lookup, warn
+        self.topics = topics or {}  # input name (odom0, ...) -> its topic, for the warnings
         self.frames = frames or Frames()
         self.two_d_mode, self.gravity = two_d_mode, gravity
         self.predict_to_current_time = predict_to_current_time
@@ -99,18 +106,18 @@ class Estimator:
         self.history_length = None
         self.state_history, self.measurement_history = collections.deque(), collections.deque()
 
-    # Inputs, as upstream's callbacks.
-    def odometry(self, pose, twist, pose_source, twist_source):
+    # Inputs, as upstream's callbacks; ``now`` is the node's clock when the message came (None: not checked).
+    def odometry(self, pose, twist, pose_source, twist_source, now=None):
         """nav_msgs/Odometry: its pose in the world frame, its twist (``twist.frame`` is the child frame)."""
-        if not self.after_set_pose(pose_source.name.rsplit("_", 1)[0], pose.stamp):
+        if not self.timely(pose_source.name.rsplit("_", 1)[0], pose.stamp, now):
             return
         if pose_source.update.any():
             self.ordered(pose_source, pose, self.prepare_pose_source, target=self.frames.world, imu=False)
         if twist_source.update.any():
             self.ordered(twist_source, twist, self.prepare_twist_source, target=self.frames.base_link)
 
-    def imu(self, message, pose_source, twist_source, acceleration_source):
-        if not self.after_set_pose(pose_source.name.rsplit("_", 1)[0], message.stamp):
+    def imu(self, message, pose_source, twist_source, acceleration_source, now=None):
+        if not self.timely(pose_source.name.rsplit("_", 1)[0], message.stamp, now):
             return
         base_link = self.frames.base_link
         if pose_source.update.any() and not ignored(message.orientation_covariance):
@@ -124,23 +131,33 @@ class Estimator:
         if acceleration_source.update.any() and not ignored(message.linear_acceleration_covariance):
             self.ordered(acceleration_source, message, self.prepare_acceleration, target=base_link)
 
-    def pose(self, message, source):
-        self.ordered(source, message, self.prepare_pose_source, target=self.frames.world, imu=False)
+    def pose(self, message, source, now=None):
+        if self.timely(source.name, message.stamp, now):
+            self.ordered(source, message, self.prepare_pose_source, target=self.frames.world, imu=False)
 
-    def twist(self, message, source):
-        self.ordered(source, message, self.prepare_twist_source, target=self.frames.base_link)
+    def twist(self, message, source, now=None):
+        if self.timely(source.name, message.stamp, now):
+            self.ordered(source, message, self.prepare_twist_source, target=self.frames.base_link)
 
-    def after_set_pose(self, name, stamp):
+    def timely(self, name, stamp, now=None):
+        """False, said once per input, for a message stamped at or before the last set_pose, or more than
+        FUTURE_LIMIT ahead of ``now``."""
         if stamp <= self.last_set_pose_time:
             self.warn(f"{name}_timestamp", f"The {name} message has a timestamp equal to or before the last filter "
                       f"reset, this message will be ignored (message time: {stamp:.3f})")
+            return False
+        if now is not None and stamp - now > FUTURE_LIMIT:
+            label = f"{name} ({self.topics[name]})" if name in self.topics else name
+            self.warn(f"{name}_future", f"The {label} message is stamped {stamp - now:.3f} s ahead of the current "
+                      f"time ({now:.3f}); messages more than {FUTURE_LIMIT:g} s ahead are ignored (message time: "
+                      f"{stamp:.3f}, said once per input)")
             return False
         return True
 
     def ordered(self, source, message, prepare, **options):
         """Upstream's per-stream checks: nothing from before the last set_pose, nothing older than the stream's
         last message; then the prepared measurement goes into the queue."""
-        if not self.after_set_pose(source.name, message.stamp):
+        if not self.timely(source.name, message.stamp):
             return
         previous_stamp = self.last_message_times.setdefault(source.name, message.stamp)
         if message.stamp < previous_stamp:
@@ -275,24 +292,28 @@ class Estimator:
     # The periodic update.
     def integrate(self, now):
         """RosFilter::integrateMeasurements: every queued measurement up to ``now`` in time order; with none
-        queued for sensor_timeout (or with predict_to_current_time) a prediction up to ``now``. With
-        smooth_lagged_data (``history_length`` set), a measurement older than the estimate first takes the filter
-        back to the state before it, and the measurements since are fused again."""
+        fused for sensor_timeout (or with predict_to_current_time) a prediction up to ``now``. Upstream predicts
+        only when the queue is empty, so data waiting for a later time stops the output; here it predicts as
+        without data. With smooth_lagged_data (``history_length`` set), a measurement older than the estimate
+        first takes the filter back to the state before it, and the measurements since are fused again."""
         predict = self.predict_to_current_time
         smoothing = self.history_length is not None
+        fused = False
         if self.queue:
             if smoothing and self.queue[0][0] < self.filter.last_measurement_time:
                 self.revert_to(self.queue[0][0] - 1e-9)
             while self.queue and self.queue[0][0] <= now:
                 measurement = heapq.heappop(self.queue)[2]
                 self.filter.process_measurement(measurement)
+                fused = True
                 if smoothing:
                     self.measurement_history.append(measurement)
                     # One saved state per distinct time.
                     if not self.queue or abs(self.queue[0][0] - self.filter.last_measurement_time) > 1e-9:
                         self.state_history.append((self.filter.last_measurement_time, self.filter.state.copy(),
                                                    self.filter.covariance.copy()))
-        elif self.filter.initialized and now - self.filter.last_measurement_time >= self.filter.sensor_timeout:
+        if (not fused and self.filter.initialized
+                and now - self.filter.last_measurement_time >= self.filter.sensor_timeout):
             predict = True
         if self.filter.initialized and predict:
             self.filter.predict_to(now)

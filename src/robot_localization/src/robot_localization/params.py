@@ -158,11 +158,15 @@ def read_config(parameters):
     config.transform_timeout = reader.number("transform_timeout", 0.0, minimum=0.0)
     config.predict_to_current_time = reader.boolean("predict_to_current_time", False)
     smooth_lagged_data = reader.boolean("smooth_lagged_data", False)
-    history_length = abs(reader.number("history_length", 0.0))
+    given = reader.number("history_length", 0.0)
     if smooth_lagged_data:
-        config.history_length = history_length
-    elif history_length > 1e-9:
-        reader.problem("warn", f"~history_length: {history_length} specified, but smooth_lagged_data is false. "
+        # Upstream uses the absolute value, saying so only below -1e9 (its test reads -1e9 for -1e-9).
+        config.history_length = abs(given)
+        if given < 0:
+            reader.problem("warn", f"~history_length: {given} specified, negative; its absolute value "
+                           f"{config.history_length} s is used")
+    elif abs(given) > 1e-9:
+        reader.problem("warn", f"~history_length: {given} specified, but smooth_lagged_data is false. "
                        "Lagged data will not be smoothed.")
     config.print_diagnostics = reader.boolean("print_diagnostics", True)
     config.gravitational_acceleration = reader.number("gravitational_acceleration", 9.80665)

@@ -66,7 +66,8 @@ class RosFilter:
         self.tf_listener = tf2_ros.TransformListener(self.tf_buffer)
         self.tf_broadcaster = tf2_ros.TransformBroadcaster()
         self.estimator = Estimator(self.lookup, self.warn_once, config.frames, config.two_d_mode,
-                                   config.gravitational_acceleration, config.predict_to_current_time)
+                                   config.gravitational_acceleration, config.predict_to_current_time,
+                                   {sensor.name: rospy.resolve_name(sensor.topic) for sensor in config.sensors})
         ekf = self.estimator.filter
         ekf.process_noise = config.process_noise_covariance
         ekf.sensor_timeout = config.sensor_timeout
@@ -143,8 +144,11 @@ class RosFilter:
         self.subscribers.append(rospy.Subscriber(sensor.topic, message_type, callback, **options))
 
     def locked(self, function, *args):
+        """An input's callback under the lock, with the clock its stamp is checked against (none under sim time
+        before the first /clock, when ROS time reads 0)."""
+        now = rospy.Time.now().to_sec()
         with self.lock:
-            function(*args)
+            function(*args, now=now if now > 0 else None)
 
     def set_pose(self, message):
         rospy.loginfo(f"Received set_pose request with value\n{message}")

@@ -17,7 +17,7 @@ Clearpath control.launch relies on diff_drive_controller's 0.25 s timeout).
 """
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 MIN_PRIORITY, MAX_PRIORITY = 0, 255
 TWIST_FIELDS = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
@@ -31,6 +31,7 @@ class Handle:
     topic: str
     timeout: float
     priority: int
+    where: str = ""  # the entry it came from, "parameter ~topics[0] ('joy')", for the lines about it
     stamp: float = 0.0
     locked_value: bool = False
 
@@ -51,24 +52,33 @@ class Handle:
 
 
 def parse_handles(kind: str, entries, parameter: str) -> Tuple[List[Handle], List[str]]:
-    """The handles of a ``topics`` or ``locks`` parameter, and one error line per entry left out. Upstream
-    stops at the first bad entry (ROS_FATAL, the rest unread); here only the bad entry is left out."""
+    """The handles of a ``topics`` or ``locks`` parameter, and one error line per entry left out or priority
+    clamped. Upstream stops at the first bad entry (ROS_FATAL, the rest unread); here only the bad entry is left
+    out. An input whose name an earlier one has is left out too: upstream selects by name, so inputs of one name
+    would pass together whatever their priorities (locks act each on its own, so theirs may repeat)."""
     if entries is None:
         return [], []
     if not isinstance(entries, list):
         return [], [f"parameter {parameter}: expected a list of entries (name, topic, timeout, priority), "
                     f"got {type(entries).__name__}"]
-    handles, errors = [], []
+    handles, errors, first_of_name = [], [], {}
     for index, entry in enumerate(entries):
         where = f"parameter {parameter}[{index}]"
         try:
-            handles.append(_handle(kind, entry, where))
+            handle = _handle(kind, entry, where, errors)
         except ValueError as error:
             errors.append(f"{where}: {error}; entry left out")
+            continue
+        if kind == "velocity" and handle.name in first_of_name:
+            first = first_of_name[handle.name]
+            errors.append(f"{where}: name {handle.name!r} is already that of {parameter}[{first}]; entry left out")
+            continue
+        first_of_name.setdefault(handle.name, index)
+        handles.append(handle)
     return handles, errors
 
 
-def _handle(kind: str, entry, where: str) -> Handle:
+def _handle(kind: str, entry, where: str, errors: List[str]) -> Handle:
     if not isinstance(entry, dict):
         raise ValueError(f"expected a dictionary with name, topic, timeout and priority, got {entry!r}")
     missing = [key for key in ("name", "topic", "timeout", "priority") if key not in entry]
@@ -84,8 +94,37 @@ def _handle(kind: str, entry, where: str) -> Handle:
     priority = entry["priority"]
     if isinstance(priority, bool) or not isinstance(priority, (int, float)) or not float(priority).is_integer():
         raise ValueError(f"priority must be an integer in [{MIN_PRIORITY}, {MAX_PRIORITY}], got {priority!r}")
-    # Upstream clamps the priority into [0, 255].
-    return Handle(kind, name, topic, float(timeout), int(min(max(priority, MIN_PRIORITY), MAX_PRIORITY)))
+    where = f"{where} ({name!r})"
+    clamped = int(min(max(priority, MIN_PRIORITY), MAX_PRIORITY))
+    if clamped != priority:
+        never = " (an input of priority 0 never passes)" if kind == "velocity" and clamped == MIN_PRIORITY else ""
+        errors.append(f"{where}: priority {priority:g} is outside [{MIN_PRIORITY}, {MAX_PRIORITY}]; {clamped} is "
+                      f"used, as upstream clamps it{never}")
+    return Handle(kind, name, topic, float(timeout), clamped, where)
+
+
+def check_topics(inputs: Sequence[Handle], locks: Sequence[Handle], output: str, resolve: Callable[[str], str]
+                 ) -> Tuple[List[Handle], List[Handle], List[str]]:
+    """The inputs and locks to subscribe, and one error line per input left out: an input on ``output`` (the
+    resolved cmd_vel_out) would feed itself, each message passing out and in again as fast as the node runs; an
+    input on a lock's topic cannot be told from it (one topic, one type; rospy would hand the lock the Twists, and
+    upstream's roscpp throws at the second subscription, uncaught), and the input goes so that a lock is never lost.
+    Topics compare as ``resolve`` (rospy.resolve_name: namespace and remappings) gives them."""
+    lock_of_topic = {}
+    for lock in locks:
+        lock_of_topic.setdefault(resolve(lock.topic), lock)
+    kept, errors = [], []
+    for handle in inputs:
+        topic = resolve(handle.topic)
+        if topic == output:
+            errors.append(f"{handle.where}: topic {topic} is cmd_vel_out, this node's output: the input would feed "
+                          "itself; entry left out")
+        elif topic in lock_of_topic:
+            errors.append(f"{handle.where}: topic {topic} is also that of the lock {lock_of_topic[topic].where}, "
+                          "which listens for std_msgs/Bool; the input is left out, the lock kept")
+        else:
+            kept.append(handle)
+    return kept, list(locks), errors
 
 
 def non_finite_field(values: Sequence[float]) -> Optional[Tuple[str, float]]:

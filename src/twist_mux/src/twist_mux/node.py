@@ -7,7 +7,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Twist
 from std_msgs.msg import Bool
 
-from .mux import HUGE_VALUE, TwistMux, huge_field, non_finite_field, parse_handles
+from .mux import HUGE_VALUE, TwistMux, check_topics, huge_field, non_finite_field, parse_handles
 
 DIAGNOSTICS_PERIOD = 1.0
 # How often a lock that engaged by timing out (its publisher gone) is looked for; a Bool engages it at once.
@@ -19,7 +19,9 @@ class TwistMuxNode:
         inputs, input_errors = parse_handles("velocity", rospy.get_param("~topics", None),
                                              rospy.resolve_name("~topics"))
         locks, lock_errors = parse_handles("lock", rospy.get_param("~locks", None), rospy.resolve_name("~locks"))
-        for error in input_errors + lock_errors:
+        inputs, locks, topic_errors = check_topics(inputs, locks, rospy.resolve_name("cmd_vel_out"),
+                                                   rospy.resolve_name)
+        for error in input_errors + lock_errors + topic_errors:
             rospy.logerr(error)
         if not inputs:
             rospy.logwarn(f"{rospy.resolve_name('~topics')}: no input topics; nothing will be published on "
