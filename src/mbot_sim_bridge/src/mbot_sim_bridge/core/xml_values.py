@@ -20,8 +20,10 @@ _FALSE = ("false", "0")
 # URDF and SDF nest about ten deep; ElementTree serialises and copies recursively, and 100,000 levels ran out of
 # Python's stack ("maximum recursion depth exceeded").
 MAX_DEPTH = 100
-# The largest XML document read (bytes): a 48 MB model took minutes to read.
+# The largest XML document read, in bytes and in elements. Python's garbage collector scans every element held
+# while it reads: at 1.7 million (a 48 MB model) each scan stopped every thread, the loop too, for up to 2 s.
 MAX_DOCUMENT_BYTES = 64 << 20
+MAX_ELEMENTS = 250_000
 # The farthest a pose or origin may place anything (m), as far as a model may be placed (engine.MAX_POSITION):
 # a link at 1e308 m overflowed the lumped inertia ("Eigenvalues did not converge").
 MAX_OFFSET = 1.0e5
@@ -55,6 +57,9 @@ def parse_xml(data, path: str, error: Type[BridgeError] = WorldError) -> XmlDocu
 
     def start(tag, attributes):
         depth[0] += 1
+        if len(lines) >= MAX_ELEMENTS:
+            raise error(f"{path}:{parser.CurrentLineNumber}: more than {MAX_ELEMENTS:,} elements; at most that many "
+                        "are read")
         if depth[0] > MAX_DEPTH:
             raise error(f"{path}:{parser.CurrentLineNumber}: <{tag}> is nested {depth[0]} elements deep; "
                         f"at most {MAX_DEPTH} are read")
