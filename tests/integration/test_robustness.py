@@ -503,8 +503,9 @@ def test_a_model_of_unknown_elements_does_not_stop_the_clock(env, bridge, monkey
     monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
     elements = "\n".join(f"<hostile_{index % 3}>text</hostile_{index % 3}>" for index in range(count))
     request = SpawnModelRequest(model_name="unknowns", model_xml=(
-        "<sdf version='1.6'><model name='m'><static>true</static><link name='l'><collision name='c'><geometry><box>"
-        f"<size>1 1 1</size></box></geometry></collision></link>\n{elements}\n</model></sdf>"))
+        "<sdf version='1.6'><model name='m'><static>true</static><pose>0 3 1 0 0 0</pose><link name='l'>"
+        "<collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link>\n"
+        f"{elements}\n</model></sdf>"))
     request.initial_pose.position.x = -5.0
     answer, longest = spawn_timing_the_clock(env, "spawn_sdf_model", request)
     warnings = [line for line in open(bridge.log_path) if "<hostile_" in line and "is not an SDF" in line]
@@ -516,6 +517,8 @@ def test_a_model_of_unknown_elements_does_not_stop_the_clock(env, bridge, monkey
         assert "unknowns" not in model_names(env)
     else:
         assert answer.success and len(warnings) == 3, (answer, warnings[:5])
+        # Where the request's pose and the model's own put it (the log said the request's alone).
+        assert "spawned SDF model 'unknowns' at (-5.0, 3.0, 1.0)" in open(bridge.log_path).read()
         assert call(env, "delete_model", "{model_name: unknowns}")["success"]
     assert_still_serving(env, bridge)
 
