@@ -448,35 +448,78 @@ def test_calls_during_a_long_step_are_carried_out_and_answered_at_once(env, brid
     assert_still_serving(env, bridge)
 
 
-def test_a_50_mb_description_does_not_stop_the_clock(env, bridge, mbot_urdf, monkeypatch):
-    """A description of 700,000 <gazebo reference> blocks (100,000 unless MBOT_FULL_SWEEP=1: the suite's time) is
-    read in the service's thread, so /clock goes on while it loads (before, it stopped for 25 s and then
-    jumped)."""
+def spawn_timing_the_clock(ros_env, service, request):
+    """Call /gazebo/``service`` with ``request`` in a thread while /clock is watched: (the answer, the longest
+    wall time in s that sim time stood still meanwhile)."""
     import rospy
-    from gazebo_msgs.srv import SpawnModel, SpawnModelRequest
+    from gazebo_msgs.srv import SpawnModel
+
+    answer = []
+    spawner = threading.Thread(target=lambda: answer.append(
+        rospy.ServiceProxy(f"/gazebo/{service}", SpawnModel)(request)), daemon=True)
+    spawner.start()
+    longest, last, times = 0.0, time.monotonic(), [sim_time(ros_env)]
+    while spawner.is_alive():
+        times.append(sim_time(ros_env))
+        now = time.monotonic()
+        if times[-1] > times[-2]:
+            longest, last = max(longest, now - last), now
+        time.sleep(0.2)
+    spawner.join()
+    assert answer, f"{service} gave no answer"
+    return answer[0], longest
+
+
+def test_a_50_mb_description_does_not_stop_the_clock(env, bridge, mbot_urdf, monkeypatch):
+    """A description of 100,000 <gazebo reference> blocks (700,000 with MBOT_FULL_SWEEP=1, refused as more than
+    250,000 elements) is read in the service's thread, so /clock goes on while it loads (before, it stopped for
+    25 s and then jumped)."""
+    from gazebo_msgs.srv import SpawnModelRequest
 
     monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
     block = '<gazebo reference="base_link"><material>Gazebo/Blue</material></gazebo>'
     blocks = 720000 if os.environ.get("MBOT_FULL_SWEEP") else 100000
     request = SpawnModelRequest(model_name="big", model_xml=mbot_urdf.replace("</robot>", block * blocks + "</robot>"))
     request.initial_pose.position.x = -3.0
-    answer = []
-    spawner = threading.Thread(target=lambda: answer.append(
-        rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel)(request)), daemon=True)
-    spawner.start()
-    longest, last, times = 0.0, time.monotonic(), [sim_time(env)]
-    while spawner.is_alive():
-        times.append(sim_time(env))
-        now = time.monotonic()
-        if times[-1] > times[-2]:
-            longest, last = max(longest, now - last), now
-        time.sleep(0.2)
-    spawner.join()
-    assert answer and answer[0].success, answer
-    print(f"figure: /clock while a {len(request.model_xml) / 1e6:.0f} MB description loaded: longest stall "
+    answer, longest = spawn_timing_the_clock(env, "spawn_urdf_model", request)
+    print(f"figure: /clock while a {len(request.model_xml) / 1e6:.0f} MB description was read: longest stall "
           f"{longest:.1f} s")
-    assert longest < 2.0  # 3.3 s at 100,000 blocks before, 0.5 s after (1.1 s at 720,000)
-    assert call(env, "delete_model", "{model_name: big}")["success"]
+    assert longest < 2.0  # 3.3 s at 100,000 blocks before, 0.5 s after (1.1 s at 720,000, now refused)
+    if blocks > 100000:  # 1.4 million elements: past the 250,000 read (xml_values.MAX_ELEMENTS)
+        assert not answer.success and "at most that many are read" in answer.status_message, answer
+    else:
+        assert answer.success, answer
+        assert call(env, "delete_model", "{model_name: big}")["success"]
+    assert_still_serving(env, bridge)
+
+
+@pytest.mark.parametrize("count", [100000] + ([1700000] if os.environ.get("MBOT_FULL_SWEEP") else []))
+def test_a_model_of_unknown_elements_does_not_stop_the_clock(env, bridge, monkeypatch, count):
+    """spawn_sdf_model read models in the loop, warning for every unknown element: a 48 MB model stopped /clock
+    for minutes and every call was refused meanwhile. It is read in the service's thread, with one warning per
+    kind of element; 1,700,000 elements (48 MB, with MBOT_FULL_SWEEP=1) are past the 250,000 read."""
+    from gazebo_msgs.srv import SpawnModelRequest
+
+    monkeypatch.setenv("ROS_MASTER_URI", env["ROS_MASTER_URI"])
+    elements = "\n".join(f"<hostile_{index % 3}>text</hostile_{index % 3}>" for index in range(count))
+    request = SpawnModelRequest(model_name="unknowns", model_xml=(
+        "<sdf version='1.6'><model name='m'><static>true</static><pose>0 3 1 0 0 0</pose><link name='l'>"
+        "<collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision></link>\n"
+        f"{elements}\n</model></sdf>"))
+    request.initial_pose.position.x = -5.0
+    answer, longest = spawn_timing_the_clock(env, "spawn_sdf_model", request)
+    warnings = [line for line in open(bridge.log_path) if "<hostile_" in line and "is not an SDF" in line]
+    print(f"figure: /clock while a {len(request.model_xml) / 1e6:.0f} MB model of unknown elements was read: "
+          f"longest stall {longest:.1f} s, {len(warnings)} warnings; {answer.status_message}")
+    assert longest < 1.0
+    if count > 250000:
+        assert not answer.success and "at most that many are read" in answer.status_message, answer
+        assert "unknowns" not in model_names(env)
+    else:
+        assert answer.success and len(warnings) == 3, (answer, warnings[:5])
+        # Where the request's pose and the model's own put it (the log said the request's alone).
+        assert "spawned SDF model 'unknowns' at (-5.0, 3.0, 1.0)" in open(bridge.log_path).read()
+        assert call(env, "delete_model", "{model_name: unknowns}")["success"]
     assert_still_serving(env, bridge)
 
 

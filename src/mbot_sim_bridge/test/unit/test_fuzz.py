@@ -27,7 +27,7 @@ from mbot_sim_bridge.core.geometry import Pose
 from mbot_sim_bridge.core.description.model_path import default_model_path
 from mbot_sim_bridge.core.plugin_table import CORE_PLUGINS
 from mbot_sim_bridge.core.description.robot_model import parse_robot
-from mbot_sim_bridge.core.description.sdf_spawn import spawn_world_xml
+from mbot_sim_bridge.core.description.sdf_spawn import read_spawned_model, spawn_world_xml
 from mbot_sim_bridge.core.description.sdf_world import parse_world
 from mbot_sim_bridge.core.simulation import Simulation
 from mbot_sim_bridge.robot_description import expand_xacro
@@ -118,7 +118,7 @@ def print_outcomes():
 
 # The fuzzers whose draws must be partly refused and partly carried out (the extreme-value, link-count and gripper
 # sweeps walk fixed lists whose outcomes their own tests check).
-MIXED_OUTCOMES = ("robot descriptions", "worlds", "service requests")
+MIXED_OUTCOMES = ("robot descriptions", "worlds", "service requests", "hostile structures")
 # The request kinds some generated requests carry out. Not spawn_sdf: its one valid model with seven finite numbers
 # is rare among the draws (none in 150 sequences with the fixed seed).
 REQUEST_KINDS = ("set_model_state", "spawn_robot", "delete", "command", "reset_world", "reset_simulation")
@@ -629,6 +629,49 @@ def test_link_counts_up_to_1000_full_sweep():
     for links in LINK_COUNTS:
         for joint_type in JOINT_TYPES:
             spawn_beside_a_crate("link counts", chain(links, joint_type), steps=20)
+
+
+# -- hostile structures: joint loops, deep nesting, many unknown elements, long chains ------------------------------
+@st.composite
+def hostile_structures(draw):
+    """(kind, model XML, whether it is SDF): a random joint graph of up to six links (loops, joints to the world,
+    links on two joints), elements nested up to 100,000 deep, up to 100,000 unknown elements, and SDF or one-line
+    URDF chains around PyBullet's 128 links."""
+    from test_hostile_models import links_and_joints, nested, sdf_chain, unknown_elements, urdf_chain
+    kind = draw(st.sampled_from(("joint graph", "depth", "unknown elements", "sdf chain", "urdf chain")))
+    if kind == "joint graph":
+        links = [f"l{index}" for index in range(draw(st.integers(1, 6)))]
+        ends = st.tuples(st.sampled_from(links + ["world"]), st.sampled_from(links))
+        joints = draw(st.lists(ends, max_size=8, unique=True))
+        return kind, links_and_joints(links, joints), True
+    if kind == "depth":
+        return kind, nested(draw(st.sampled_from((10, 98, 99, 100, 1000, 100000)))), True
+    if kind == "unknown elements":
+        return kind, unknown_elements(draw(st.sampled_from((1, 1000, 100000)))), True
+    links = draw(st.integers(1, 130))
+    return (kind, sdf_chain(links), True) if kind == "sdf chain" else (kind, urdf_chain(links), False)
+
+
+@settings(FUZZ, max_examples=draws(15, 150))
+@given(case=hostile_structures())
+def test_hostile_structures_load_or_are_refused_in_one_line(case, simulation):
+    kind, xml, sdf = case
+    try:
+        with watchdog():
+            if sdf:
+                simulation.add_world(read_spawned_model(xml, "hostile", Pose((0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1.0))))
+            else:
+                simulation.spawn_robot(parse_robot(xml, "model 'hostile'"), "hostile")
+    except BridgeError as error:
+        assert "hostile" not in simulation.model_names(), "a refused model was left behind"
+        refused("hostile structures", error)
+        return
+    try:
+        with watchdog():
+            step_and_check(simulation, kind)
+        tally("hostile structures", f"loaded ({kind})")
+    finally:
+        simulation.delete("hostile")
 
 
 # -- gripper goals at and past the finger's limits ----------------------------------------------------------------

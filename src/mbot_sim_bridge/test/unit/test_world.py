@@ -421,7 +421,7 @@ def test_a_file_without_a_world_is_a_world_error(tmp_path):
 
 @pytest.mark.parametrize("bad, message", [
     ("<box><size>1 1</size></box>", "<size>: expected 3 numbers, got '1 1'"),
-    ("<sphere><radius>-1</radius></sphere>", "<radius>: -1 is outside the valid range > 0"),
+    ("<sphere><radius>-1</radius></sphere>", "<radius>: -1 is outside the valid range > 0 and <= 100000"),
     ("<sphere><radius>nan</radius></sphere>", "<radius>: NaN is not a valid value: 'nan'"),
     ("<box><size>1 inf 1</size></box>", "<size>: infinity is not a valid value: '1 inf 1'"),
 ])
@@ -474,7 +474,8 @@ def test_what_is_not_simulated_warns_once_each_and_the_rest_loads(caplog, client
     # The world's <plugin>s are the Simulation's to build or report (test_link_attacher.py): the reading is silent.
     assert sorted(warnings_in(caplog)) == sorted([
         at("<actor") + "<actor name='walker'> is not simulated; ignored",
-        at("<teleporter") + "<teleporter> is not an SDF <world> element; ignored",
+        at("<teleporter") + "<teleporter> is not an SDF <world> element; ignored, here and wherever else this file "
+                            "has it",
         at("<polyline>") + "<polyline> is not supported; collision 'post' of model 'door' skipped",
         at("<gravity>") + "<gravity>false</gravity> in link 'panel' of model 'door' is not simulated",
         at("<gripper") + "<gripper name='grip'> is not simulated; ignored",

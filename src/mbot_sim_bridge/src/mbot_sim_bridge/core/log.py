@@ -8,6 +8,7 @@ import logging
 import os
 import sys
 import threading
+from typing import Hashable, Optional
 
 _warned = set()
 _warned_lock = threading.Lock()
@@ -18,17 +19,19 @@ def get_logger(module_name: str) -> logging.Logger:
     return logging.getLogger("rosout." + module_name)
 
 
-def log_once(logger: logging.Logger, level: int, message: str) -> None:
-    """Log ``message`` at ``level`` the first time this exact text is seen in the process."""
+def log_once(logger: logging.Logger, level: int, message: str, key: Optional[Hashable] = None) -> None:
+    """Log ``message`` at ``level`` the first time this exact text (or ``key``, for a message that names one of
+    many places of the same problem) is seen in the process."""
+    seen = message if key is None else key
     with _warned_lock:
-        if message in _warned:
+        if seen in _warned:
             return
-        _warned.add(message)
+        _warned.add(seen)
     logger.log(level, message)
 
 
-def warn_once(logger: logging.Logger, message: str) -> None:
-    log_once(logger, logging.WARNING, message)
+def warn_once(logger: logging.Logger, message: str, key: Optional[Hashable] = None) -> None:
+    log_once(logger, logging.WARNING, message, key)
 
 
 def info_once(logger: logging.Logger, message: str) -> None:

@@ -17,6 +17,18 @@ from .geometry import IDENTITY, Pose, pose_from_xyz_rpy
 
 _TRUE = ("true", "1")
 _FALSE = ("false", "0")
+# URDF and SDF nest about ten deep; ElementTree serialises and copies recursively, and 100,000 levels ran out of
+# Python's stack ("maximum recursion depth exceeded").
+MAX_DEPTH = 100
+# The largest XML document read, in bytes and in elements. Python's garbage collector scans every element held
+# while it reads: at 1.7 million (a 48 MB model) each scan stopped every thread, the loop too, for up to 2 s.
+MAX_DOCUMENT_BYTES = 64 << 20
+MAX_ELEMENTS = 250_000
+# The farthest a pose or origin may place anything (m), as far as a model may be placed (engine.MAX_POSITION):
+# a link at 1e308 m overflowed the lumped inertia ("Eigenvalues did not converge").
+MAX_OFFSET = 1.0e5
+# The largest size of a shape (m), as far: a box of 1e308 m was frozen and deleted within 10 ms of its spawn.
+MAX_SHAPE_SIZE = 1.0e5
 
 
 class XmlDocument(NamedTuple):
@@ -36,15 +48,29 @@ class XmlDocument(NamedTuple):
 
 def parse_xml(data, path: str, error: Type[BridgeError] = WorldError) -> XmlDocument:
     """ElementTree built through expat, so that every element keeps its line number for messages."""
+    if len(data) > MAX_DOCUMENT_BYTES:
+        raise error(f"{path}: {len(data) / (1 << 20):.0f} MB of XML; at most {MAX_DOCUMENT_BYTES >> 20} MB is read")
     builder = ET.TreeBuilder(insert_comments=False)
     parser = expat.ParserCreate()
     lines = {}
+    depth = [0]
 
     def start(tag, attributes):
+        depth[0] += 1
+        if len(lines) >= MAX_ELEMENTS:
+            raise error(f"{path}:{parser.CurrentLineNumber}: more than {MAX_ELEMENTS:,} elements; at most that many "
+                        "are read")
+        if depth[0] > MAX_DEPTH:
+            raise error(f"{path}:{parser.CurrentLineNumber}: <{tag}> is nested {depth[0]} elements deep; "
+                        f"at most {MAX_DEPTH} are read")
         lines[builder.start(tag, attributes)] = parser.CurrentLineNumber
 
+    def end(tag):
+        depth[0] -= 1
+        builder.end(tag)
+
     parser.StartElementHandler = start
-    parser.EndElementHandler = builder.end
+    parser.EndElementHandler = end
     parser.CharacterDataHandler = builder.data
     try:
         parser.Parse(data, True)
@@ -162,13 +188,15 @@ def read_number(parent: Optional[ET.Element], tag: str, document: XmlDocument, d
 
 
 def read_vector(parent: Optional[ET.Element], tag: str, document: XmlDocument, default: Tuple[float, ...],
-                count: int = 3, positive: bool = False) -> Tuple[float, ...]:
+                count: int = 3, positive: bool = False, maximum: Optional[float] = None) -> Tuple[float, ...]:
     element = parent.find(tag) if parent is not None else None
     if element is None:
         return default
     values = _values(element, document, count, f"<{tag}>")
     if positive and min(values) <= 0.0:
         raise document.fail(element, f"<{tag}> must be positive, got '{element.text.strip()}'")
+    if maximum is not None and max(values) > maximum:
+        raise document.fail(element, f"<{tag}> must be at most {maximum:g}, got '{element.text.strip()}'")
     return values
 
 
@@ -177,7 +205,14 @@ def read_pose(element: Optional[ET.Element], document: XmlDocument) -> Pose:
     if element is None or not (element.text or "").strip():
         return IDENTITY
     values = _values(element, document, 6, "<pose> (x y z roll pitch yaw)")
+    _check_offset(values[:3], document, element, "<pose>")
     return pose_from_xyz_rpy(values[:3], values[3:])
+
+
+def _check_offset(position: Sequence[float], document: XmlDocument, element: ET.Element, name: str):
+    if max(abs(value) for value in position) > MAX_OFFSET:
+        raise document.fail(element, f"{name}: position {' '.join(f'{value:g}' for value in position)} is beyond "
+                                     f"±{MAX_OFFSET:g} m")
 
 
 def read_bool(element: Optional[ET.Element], document: XmlDocument, default: bool = False) -> bool:
@@ -211,5 +246,6 @@ def read_origin(parent: ET.Element, document: XmlDocument) -> Pose:
     origin = parent.find("origin")
     if origin is None:
         return IDENTITY
-    return pose_from_xyz_rpy(read_attribute_numbers(origin, "xyz", document, (0.0, 0.0, 0.0)),
-                             read_attribute_numbers(origin, "rpy", document, (0.0, 0.0, 0.0)))
+    xyz = read_attribute_numbers(origin, "xyz", document, (0.0, 0.0, 0.0))
+    _check_offset(xyz, document, origin, "<origin xyz>")
+    return pose_from_xyz_rpy(xyz, read_attribute_numbers(origin, "rpy", document, (0.0, 0.0, 0.0)))

@@ -19,11 +19,12 @@ from xml.etree import ElementTree
 
 import numpy as np
 
+from ..entity_properties import MAX_DAMPING
 from ..errors import ModelError
 from ..geometry import IDENTITY, Pose, compose, rotate, rotation_matrix, rpy
 from ..log import get_logger, warn_once
-from ..xml_values import (XmlDocument, check_range, parse_float, parse_floats, parse_xml, read_attribute_numbers,
-                          read_origin)
+from ..xml_values import (MAX_SHAPE_SIZE, XmlDocument, check_range, parse_float, parse_floats, parse_xml,
+                          read_attribute_numbers, read_origin)
 
 _logger = get_logger(__name__)
 
@@ -68,8 +69,6 @@ DEFAULT_MU = 1.0
 # give it 1 kg and unit inertia.
 _NEGLIGIBLE_MASS = 1e-9
 _NEGLIGIBLE_INERTIA = 1e-12
-# Shapes no larger than the farthest a model may be placed (engine.MAX_POSITION, m).
-_MAX_SHAPE_SIZE = 1e5
 _SHAPE_SIZES = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),)}
 # kg and kg·m²: far beyond any robot; larger values are typos that Bullet's solver cannot integrate.
 _MAX_MASS = 1e9
@@ -305,6 +304,15 @@ def _mimic(element: ElementTree.Element, where: str, document: XmlDocument) -> O
     return mimic.get("joint"), multiplier, offset
 
 
+def _check_dynamics(dynamics: Optional[ElementTree.Element], document: XmlDocument, joint_name: str):
+    """<dynamics damping friction> within set_joint_properties' bounds: Bullet turned a damping of 1e308 NaN."""
+    for name in ("damping", "friction") if dynamics is not None else ():
+        try:
+            check_range(read_attribute_numbers(dynamics, name, document, (0.0,), 1)[0], 0.0, MAX_DAMPING)
+        except ValueError as error:
+            raise ModelError(f"{document.where(dynamics)}: joint '{joint_name}': <dynamics {name}>: {error}") from None
+
+
 def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDocument) -> dict:
     limit = element.find("limit")
     if limit is None:
@@ -312,6 +320,11 @@ def _joint_limits(element: ElementTree.Element, joint_type: str, document: XmlDo
     lower, upper, effort, velocity = (read_attribute_numbers(limit, name, document, (default,), 1)[0]
                                       for name, default in (("lower", 0.0), ("upper", 0.0), ("effort", 0.0),
                                                             ("velocity", 0.0)))
+    for name, value in (("effort", effort), ("velocity", velocity)):
+        if value < 0.0:
+            # ros_control's saturation would clamp every command to this negative bound.
+            raise document.fail(limit, f"joint '{element.get('name')}': <limit {name}=\"{value:g}\"> is negative; "
+                                       "it is at least 0 (0 or none: no limit)")
     values = {"effort": effort, "velocity": velocity, "has_limit": True}
     if joint_type != "continuous":
         values.update(lower=lower, upper=upper)
@@ -332,7 +345,12 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
             raise ModelError(f"{source}: link '{link_name}' is defined twice")
         inertial = element.find("inertial")
         mass = 0.0
-        if inertial is not None and inertial.find("mass") is not None:
+        if inertial is not None and (inertial.find("mass") is None or inertial.find("mass").get("value") is None):
+            # urdfdom's rules; read as no <inertial>, a chain of 1,000 such links was cut to its root.
+            where = document.where(inertial if inertial.find("mass") is None else inertial.find("mass"))
+            raise ModelError(f"{where}: link '{link_name}': " + ("<inertial> has no <mass>" if inertial.find("mass")
+                             is None else "<mass> has no value attribute (<mass value=\"1.0\"/>)"))
+        if inertial is not None:
             mass = read_attribute_numbers(inertial.find("mass"), "value", document, (0.0,), 1)[0]
             try:
                 check_range(mass, 0.0, _MAX_MASS, least_positive=_LEAST_MASS)
@@ -374,6 +392,7 @@ def parse_robot(urdf_xml: str, source: str = "robot_description") -> RobotModel:
             raise ModelError(f"{document.where(axis_element)}: joint '{joint_name}': "
                              f"<axis xyz=\"{axis_element.get('xyz')}\"> has no direction; "
                              f"a {joint_type} joint needs an axis of length at least {_MIN_AXIS_LENGTH:g}")
+        _check_dynamics(element.find("dynamics"), document, joint_name)
         limit = element.find("limit")
         if limit is None and joint_type in ("revolute", "prismatic"):
             # urdfdom's own rule; PyBullet said only "Cannot load URDF file", naming the robot.
@@ -458,7 +477,7 @@ def _with_treads(urdf: str, wheels) -> str:
             tread.find("geometry/cylinder").set("length", repr(TREAD_WIDTH))
             link.insert(list(link).index(collision), tread)
             cylinder.set("radius", repr(radius * (1.0 - SIDE_CLEARANCE)))
-    return ElementTree.tostring(robot, encoding="unicode")
+    return pybullet_text(robot)
 
 
 def _friction(text: Optional[str], source: str, link: str, tag: str) -> float:
@@ -645,7 +664,7 @@ def _numbers_problem(shape: ElementTree.Element, attribute: str, count: int, opt
         return None if optional else f"<{shape.tag}> needs {attribute}"
     try:
         for value in parse_floats(text, count):
-            check_range(abs(value) if minimum is None else value, minimum or 0.0, _MAX_SHAPE_SIZE,
+            check_range(abs(value) if minimum is None else value, minimum or 0.0, MAX_SHAPE_SIZE,
                         exclusive_minimum=True)
     except ValueError as error:
         return f"<{shape.tag} {attribute}>: {error}"
@@ -737,6 +756,13 @@ def _pybullet_urdf(root: ElementTree.Element, links, joints, dropped: List[str],
         element.find("parent").set("link", holder)
         _move(element, offset, document)
         robot.append(element)
+    return pybullet_text(robot)
+
+
+def pybullet_text(robot: ElementTree.Element) -> str:
+    """``robot`` as text with one element per line. PyBullet's URDF reader misreads long lines: one-line chains of
+    24 to 127 links were refused ("Cannot load URDF file", naming garbled elements such as ``inertia60``)."""
+    ElementTree.indent(robot, space="")
     return ElementTree.tostring(robot, encoding="unicode")
 
 

@@ -26,12 +26,13 @@ import math
 import xml.etree.ElementTree as ET
 from typing import Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple
 
+from ..entity_properties import MAX_DAMPING
 from ..errors import ModelError
 from ..geometry import IDENTITY, Pose, compose, inverse, rotate, rpy
 from ..log import get_logger, warn_once
-from ..xml_values import XmlDocument, read_bool, read_number, read_pose, read_text, read_vector
+from ..xml_values import MAX_SHAPE_SIZE, XmlDocument, read_bool, read_number, read_pose, read_text, read_vector
 from .materials import sdf_material_rgba
-from .robot_model import BALL_JOINT_TYPE, RobotModel, parse_robot
+from .robot_model import BALL_JOINT_TYPE, RobotModel, parse_robot, pybullet_text
 
 _log = get_logger(__name__)
 
@@ -121,6 +122,9 @@ class SdfToUrdf:
         children = {joint.child: joint for joint in joints}
         anchored = self.static or any(joint.parent == "world" for joint in joints)
         free = [name for name in links if name not in children]
+        if not free and not anchored:
+            raise ModelError(f"{self.label}: joints {', '.join(repr(joint.name) for joint in joints)} form a loop: "
+                             "every link is a joint's child, so none is the model's root")
         root = "world" if anchored else free[0]
         unjointed = [name for name in free if name != root]
         frames = {name: links[name].world for name in free}
@@ -140,7 +144,7 @@ class SdfToUrdf:
         plugins = [plugin for level in self.levels for plugin in level.element.findall("plugin")]
         for plugin in plugins + list(self._added_plugins):
             ET.SubElement(robot, "gazebo").append(copy.deepcopy(plugin))
-        model = parse_robot(ET.tostring(robot, encoding="unicode"), self.label)
+        model = parse_robot(pybullet_text(robot), self.label)
         for name, link in links.items():
             if not _same_pose(frames[name], link.world):
                 model.reported_frames[name] = compose(inverse(frames[name]), link.world)
@@ -235,7 +239,7 @@ class SdfToUrdf:
                             f"sensors or plugins; {label} left out")
             return None
         if shape.tag == "box":
-            size = read_vector(shape, "size", document, (1.0, 1.0, 1.0), positive=True)
+            size = read_vector(shape, "size", document, (1.0, 1.0, 1.0), positive=True, maximum=MAX_SHAPE_SIZE)
             ET.SubElement(urdf, "box", size=" ".join(repr(v) for v in size))
         elif shape.tag == "mesh":
             uri = read_text(shape, "uri")
@@ -246,9 +250,11 @@ class SdfToUrdf:
             scale = read_vector(shape, "scale", document, (1.0, 1.0, 1.0))
             ET.SubElement(urdf, "mesh", filename=path, scale=" ".join(repr(v) for v in scale))
         else:
-            attributes = {"radius": repr(read_number(shape, "radius", document, 1.0, positive=True))}
+            attributes = {"radius": repr(read_number(shape, "radius", document, 1.0, positive=True,
+                                                     maximum=MAX_SHAPE_SIZE))}
             if shape.tag == "cylinder":
-                attributes["length"] = repr(read_number(shape, "length", document, 1.0, positive=True))
+                attributes["length"] = repr(read_number(shape, "length", document, 1.0, positive=True,
+                                                        maximum=MAX_SHAPE_SIZE))
             ET.SubElement(urdf, shape.tag, **attributes)
         return urdf
 
@@ -324,7 +330,8 @@ class SdfToUrdf:
         ET.SubElement(element, "limit", **attributes)
         dynamics = axis.find("dynamics") if axis is not None else None
         if dynamics is not None:
-            ET.SubElement(element, "dynamics", **{tag: repr(read_number(dynamics, tag, document, 0.0, minimum=0.0))
+            ET.SubElement(element, "dynamics", **{tag: repr(read_number(dynamics, tag, document, 0.0, minimum=0.0,
+                                                                        maximum=MAX_DAMPING))
                                                   for tag in ("damping", "friction")})
             for tag in ("spring_stiffness", "spring_reference"):
                 if read_number(dynamics, tag, document, 0.0) != 0.0:

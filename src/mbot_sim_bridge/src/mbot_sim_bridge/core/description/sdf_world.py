@@ -19,18 +19,20 @@ from ..errors import ModelError, WorldError
 from ..geometry import IDENTITY, Pose, compose
 from ..joints.model_configuration import requested_positions
 from ..log import get_logger, warn_once
+from ..physics_properties import MAX_GRAVITY, MAX_TIME_STEP, MAX_UPDATE_RATE, MIN_TIME_STEP
 from .materials import sdf_material_rgba
 from .mesh import TriangleMesh, load_mesh
 from .model_path import MODEL_MANIFESTS, default_model_path, find_model_directory
 from .sdf_model import ModelLevel, SdfToUrdf, is_articulated, state_joint_positions
 from .world_description import (SHAPE_KINDS, ArticulatedModel, LinkDescription, ModelDescription, PhysicsConfig, Shape,
                                 WorldDescription)
-from ..xml_values import (XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute, read_number,
-                          read_pose, read_text, read_vector, read_xml_file)
+from ..xml_values import (MAX_SHAPE_SIZE, XmlDocument, check_range, parse_xml, read_bool, read_bool_attribute,
+                          read_number, read_pose, read_text, read_vector, read_xml_file)
 
 _log = get_logger(__name__)
 
 SDF_VERSION = (1, 7)  # newest spec followed here; model.config picks the best model file up to it
+NEWEST_SDF_VERSION = (1, 12)  # the newest there is (sdformat 15): a file of a later one is refused
 
 # Gazebo ships these two, so worlds include them without shipping them; the model path still wins.
 _BUILTIN_MODELS = {
@@ -134,12 +136,17 @@ class _WorldParser:
         self._model_path = [str(directory) for directory in model_path]
         self._documents = {}
         self._meshes = {}
+        self._left_out = []
 
     def parse(self, path: str) -> WorldDescription:
         document = self._read(path)
         world = document.root.find("world")
         if document.root.tag != "sdf" or world is None:
             raise WorldError(f"{path}: not an SDF world: no <sdf><world> element")
+        worlds = document.root.findall("world")
+        if len(worlds) > 1:
+            raise WorldError(f"{document.where(worlds[1])}: a second <world>; a file holds one (Gazebo would simulate "
+                             "the first, however empty)")
         self._check_version(document)
         scope = _Frames(f"world '{world.get('name', 'default')}'", IDENTITY, ("", "world"))
         entries, others = [], []
@@ -153,6 +160,8 @@ class _WorldParser:
                     others.append(child)
             elif child.tag == "frame":
                 scope.add(child.get("name", ""), child.find("pose"), document, child.get("attached_to", ""))
+            elif child.tag == "plugin":
+                _check_plugin(child, document, f"world '{world.get('name', 'default')}'")
             elif child.tag in _WORLD_UNSUPPORTED:
                 self._warn_unsupported(document, child)
             elif child.tag not in _WORLD_IGNORED:
@@ -174,7 +183,8 @@ class _WorldParser:
         return WorldDescription(world.get("name", "default"), path, self._physics(document, world),
                                 tuple(model for model in models if isinstance(model, ModelDescription)),
                                 tuple(others),
-                                tuple(model for model in models if isinstance(model, ArticulatedModel)))
+                                tuple(model for model in models if isinstance(model, ArticulatedModel)),
+                                tuple(self._left_out))
 
     # Files ---------------------------------------------------------------------------------------------
 
@@ -185,6 +195,10 @@ class _WorldParser:
 
     def _check_version(self, document: XmlDocument) -> None:
         version = _version(document.root.get("version", ""))
+        if document.root.get("version") is not None and not (1, 0) <= version <= NEWEST_SDF_VERSION:
+            raise document.fail(document.root, f"<sdf version=\"{document.root.get('version', '')}\"> is not an SDF "
+                                               f"version: they run from 1.0 to "
+                                               f"{'.'.join(map(str, NEWEST_SDF_VERSION))}")
         if version > SDF_VERSION:
             warn_once(_log, f"{document.path}: SDF {document.root.get('version')} is newer than "
                             f"{'.'.join(map(str, SDF_VERSION))}, the newest read here")
@@ -245,9 +259,14 @@ class _WorldParser:
             try:
                 self._meshes[path] = load_mesh(path)
             except ModelError as error:
-                warn_once(_log, f"{error}; collisions using it are skipped")
+                self._leave_out(f"{error}; collisions using it are skipped")
                 self._meshes[path] = None
         return self._meshes[path]
+
+    def _leave_out(self, message: str) -> None:
+        """Warn once that a file the world names is not simulated, and keep the reason (WorldDescription.left_out)."""
+        warn_once(_log, message)
+        self._left_out.append(message)
 
     # Elements ------------------------------------------------------------------------------------------
 
@@ -259,7 +278,7 @@ class _WorldParser:
         model_document = self._model_document(uri, document)
         if model_document is None:
             searched = ":".join(self._model_path) or "(empty)"
-            warn_once(_log, f"{document.where(include)}: cannot find '{uri}' (model path: {searched}); skipped")
+            self._leave_out(f"{document.where(include)}: cannot find '{uri}' (model path: {searched}); skipped")
             return []
         self._check_version(model_document)
         model = model_document.root.find("model")
@@ -300,6 +319,9 @@ class _WorldParser:
         (an included file is read once, so including a model inside itself meets the same element again)."""
         element, document = entry.element, entry.document
         nested = []
+        _check_link_names(element, document, entry.name)
+        for plugin in element.findall("plugin") + element.findall("link/sensor/plugin"):
+            _check_plugin(plugin, document, f"model '{entry.name}'")
         for child in element:
             if child.tag in ("link", "frame"):
                 default = child.get("attached_to", "") if child.tag == "frame" else ""
@@ -401,13 +423,14 @@ class _WorldParser:
                       mu=read_number(friction, "mu", document, 1.0) if friction is not None else 1.0,
                       mu2=read_number(friction, "mu2", document, 1.0) if friction is not None else 1.0)
         if kind == "box":
-            return Shape(size=read_vector(kind_element, "size", document, (1.0, 1.0, 1.0), positive=True), **common)
+            return Shape(size=read_vector(kind_element, "size", document, (1.0, 1.0, 1.0), positive=True,
+                                          maximum=MAX_SHAPE_SIZE), **common)
         if kind == "sphere":
-            radius = read_number(kind_element, "radius", document, 1.0, positive=True)
+            radius = read_number(kind_element, "radius", document, 1.0, positive=True, maximum=MAX_SHAPE_SIZE)
             return Shape(size=(2.0 * radius,) * 3, radius=radius, **common)
         if kind == "cylinder":
-            radius = read_number(kind_element, "radius", document, 1.0, positive=True)
-            length = read_number(kind_element, "length", document, 1.0, positive=True)
+            radius = read_number(kind_element, "radius", document, 1.0, positive=True, maximum=MAX_SHAPE_SIZE)
+            length = read_number(kind_element, "length", document, 1.0, positive=True, maximum=MAX_SHAPE_SIZE)
             return Shape(size=(2.0 * radius, 2.0 * radius, length), radius=radius, length=length, **common)
         if kind == "plane":
             if not static:
@@ -425,7 +448,7 @@ class _WorldParser:
         uri = read_text(mesh, "uri")
         path = self._mesh_path(uri, document) if uri else None
         if path is None:
-            warn_once(_log, f"{document.where(mesh)}: cannot find mesh '{uri}'; {label} skipped")
+            self._leave_out(f"{document.where(mesh)}: cannot find mesh '{uri}'; {label} skipped")
             return None
         if mesh.find("submesh") is not None:
             warn_once(_log, f"{document.where(mesh.find('submesh'))}: <submesh> is not supported; "
@@ -445,13 +468,15 @@ class _WorldParser:
         defaults = PhysicsConfig()
         values = {}
         if chosen is not None:
+            # The bounds set_physics_properties keeps to (physics_properties).
             values = dict(
                 max_step_size=read_number(chosen, "max_step_size", document, defaults.max_step_size,
-                                          positive=True),
+                                          minimum=MIN_TIME_STEP, maximum=MAX_TIME_STEP),
                 real_time_factor=read_number(chosen, "real_time_factor", document, defaults.real_time_factor,
                                              minimum=0.0),
                 real_time_update_rate=read_number(chosen, "real_time_update_rate", document,
-                                                  defaults.real_time_update_rate, minimum=0.0))
+                                                  defaults.real_time_update_rate, minimum=0.0,
+                                                  maximum=MAX_UPDATE_RATE))
             constraints = chosen.find("ode/constraints")
             for tag, maximum in _CONSTRAINT_LIMITS.items():
                 values[tag] = read_number(constraints, tag, document, getattr(defaults, tag), minimum=0.0,
@@ -463,6 +488,9 @@ class _WorldParser:
         for parent in (world, chosen):
             if parent is not None and parent.find("gravity") is not None:
                 values["gravity"] = read_vector(parent, "gravity", document, defaults.gravity)
+                if max(abs(value) for value in values["gravity"]) > MAX_GRAVITY:
+                    raise document.fail(parent.find("gravity"), f"<gravity>: {parent.findtext('gravity').strip()} "
+                                                                f"is beyond ±{MAX_GRAVITY:g} m/s² on an axis")
                 break
         return PhysicsConfig(**values)
 
@@ -475,7 +503,29 @@ class _WorldParser:
 
     @staticmethod
     def _warn_unknown(document: XmlDocument, element: ET.Element, parent: str) -> None:
-        warn_once(_log, f"{document.where(element)}: <{element.tag}> is not an SDF <{parent}> element; ignored")
+        # Once per file and kind, at the first: a model of a million of them logged for minutes.
+        warn_once(_log, f"{document.where(element)}: <{element.tag}> is not an SDF <{parent}> element; ignored, "
+                        "here and wherever else this file has it",
+                  key=("unknown element", document.path, parent, element.tag))
+
+
+def _check_link_names(model: ET.Element, document: XmlDocument, model_name: str) -> None:
+    """sdformat's rules for link names: given, unique in their model, and without '::', which scopes nested
+    models' names."""
+    seen = set()
+    for link in model.findall("link"):
+        name = link.get("name", "")
+        problem = ("has no name" if not name else f"'{name}' is defined twice" if name in seen
+                   else f"'{name}' holds '::', which SDF keeps for nested models' names" if "::" in name else None)
+        if problem:
+            raise document.fail(link, f"model '{model_name}': a <link> {problem}")
+        seen.add(name)
+
+
+def _check_plugin(plugin: ET.Element, document: XmlDocument, owner: str) -> None:
+    if not plugin.get("filename", "").strip():
+        raise document.fail(plugin, f"{owner}: <plugin name='{plugin.get('name', '')}'> has no filename, which "
+                                    "sdformat requires")
 
 
 # --- Values -------------------------------------------------------------------------------------------------

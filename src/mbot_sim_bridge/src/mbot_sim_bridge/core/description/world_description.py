@@ -129,6 +129,8 @@ class WorldDescription:
     # World children other than models, physics, gravity and frames (lights, scene, gui...), kept for saving.
     others: Tuple[ET.Element, ...] = field(default=(), compare=False, repr=False)
     robots: Tuple[ArticulatedModel, ...] = ()
+    # Why files it names are not simulated (a mesh or <include> not found or unreadable), each warned once.
+    left_out: Tuple[str, ...] = field(default=(), compare=False)
 
     @property
     def plugins(self) -> Tuple[ET.Element, ...]:
