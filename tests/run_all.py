@@ -19,12 +19,33 @@ REPORT = os.path.join(ROOT, "build", "test_results", "pytest.xml")
 # --dist loadgroup hands out tests one by one, keeping together those that share a module-scoped fixture (one
 # simulator shared by a module's tests; see the workspace's conftest.py).
 WORKERS = 2 * (os.cpu_count() or 1)
+# The suite's time budget by area (tests/README.md, "The suite's budget"): an area's share of the wall time is the
+# sum of its tests' durations over the number of workers. A test's area is the first of these whose prefix its
+# junit classname (its path, dotted) has; rostest files, wherever they are, count as "rostest". The budgets are
+# printed against what the run measured, never enforced: a timed test on a shared machine would flake.
+AREAS = (
+    ("simulator", ("src.mbot_sim_bridge.",), 75),
+    ("batch", ("src.mbot_batch.",), 50),
+    ("course", ("src.mbot_gazebo.", "src.mbot_teleop.", "src.mbot_description."), 25),
+    ("integration", ("tests.integration.",), 110),
+    ("docs and style", ("tests.unit.",), 30),
+    ("stand-ins", ("src.",), 45),
+)
+ROSTEST_BUDGET_SECONDS = 100
+
+
+def area_of(classname, is_rostest):
+    if is_rostest:
+        return "rostest"
+    return next((name for name, prefixes, _ in AREAS if classname.startswith(prefixes)), "other")
 
 
 def count(report):
-    """(passed, failed, skipped, figures) from pytest's junit report; a rostest item counts its test cases."""
+    """(passed, failed, skipped, figures, seconds by area) from pytest's junit report; a rostest item counts its
+    test cases."""
     passed = failed = skipped = 0
     figures = []
+    area_seconds = {}
     for case in ET.parse(report).getroot().iter("testcase"):
         properties = {}
         for prop in case.iter("property"):
@@ -33,6 +54,8 @@ def count(report):
             else:
                 properties[prop.get("name")] = prop.get("value")
         outcome_failed = case.find("failure") is not None or case.find("error") is not None
+        area = area_of(case.get("classname", ""), "rostest_tests" in properties)
+        area_seconds[area] = area_seconds.get(area, 0.0) + float(case.get("time") or 0.0)
         if "rostest_tests" in properties:
             cases, cases_failed = int(properties["rostest_tests"]), int(properties["rostest_failed"])
             passed += cases - min(cases_failed, cases)
@@ -43,7 +66,30 @@ def count(report):
             skipped += 1
         else:
             passed += 1
-    return passed, failed, skipped, figures
+    return passed, failed, skipped, figures, area_seconds
+
+
+def budget_lines(area_seconds, workers):
+    """One line an area: its share of the wall time against its budget, most expensive first."""
+    budgets = {name: budget for name, _, budget in AREAS}
+    budgets["rostest"] = ROSTEST_BUDGET_SECONDS
+    lines = []
+    for area, seconds in sorted(area_seconds.items(), key=lambda item: -item[1]):
+        share = seconds / workers
+        budget = budgets.get(area)
+        verdict = "no budget" if budget is None else f"budget {budget} s" + (", OVER" if share > budget else "")
+        lines.append(f"area {area}: {share:.0f} s of the wall time ({seconds:.0f} s over {workers} workers; "
+                     f"{verdict})")
+    return lines
+
+
+def workers_of(arguments):
+    """The number of workers the run had: the default, or the last -n given."""
+    workers = WORKERS
+    for flag, value in zip(arguments, arguments[1:]):
+        if flag == "-n" and value.isdigit():
+            workers = max(int(value), 1)
+    return workers
 
 
 def main(arguments):
@@ -64,11 +110,13 @@ def main(arguments):
     if not os.path.exists(REPORT):
         print("summary: 0 passed, 1 failed")
         return 1
-    passed, failed, skipped, figures = count(REPORT)
+    passed, failed, skipped, figures, area_seconds = count(REPORT)
     if code not in (0, 1) and not failed:
         failed = 1
     for figure in figures:
         print(f"figure: {figure}")
+    for line in budget_lines(area_seconds, workers_of(arguments)):
+        print(line)
     print(f"summary: {passed} passed, {failed} failed" + (f", {skipped} skipped" if skipped else ""))
     return 1 if failed else 0
 
