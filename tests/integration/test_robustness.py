@@ -414,6 +414,76 @@ def test_set_model_state_with_an_overflowing_quaternion(env, bridge):
 
 
 # -- issue 39: calls during long work, a description too big to read in the loop, more joints than PyBullet holds ---
+# -- issue 54, 5: a robot namespace ROS cannot take is refused, from spawn_model and from a plugin's tag ----------
+def test_robot_namespaces_ros_cannot_take_are_refused_with_one_line(env, bridge, tmp_path, mbot_urdf):
+    """~priv, 'a b' and /../.. answered success; then the joint_states check's thread died on ~priv, and rospy
+    could not register 'a b's topics."""
+    for namespace, expected in (("~priv", "is a private name"), ("a b", "is not a legal ROS name"),
+                                ("/../..", "is not a legal ROS name")):
+        result = spawn(env, tmp_path, "bad", without_namespace(mbot_urdf), "-robot_namespace", namespace)
+        assert_refused(result, "bad", f"SpawnModel: robot_namespace '{namespace}' {expected}")
+    result = spawn(env, tmp_path, "bad", NAN_POSE_SDF.replace("nan", "5"), "-robot_namespace", "a b", kind="-sdf")
+    assert_refused(result, "bad", "SpawnModel: robot_namespace 'a b' is not a legal ROS name")
+    result = spawn(env, tmp_path, "bad", with_drive_tags(mbot_urdf, robotNamespace="a b"))
+    assert_refused(result, "bad", "GazeboRosDiffDrive", "<robotNamespace> 'a b' is not a legal ROS name")
+    assert "bad" not in model_names(env)
+    assert_still_serving(env, bridge)
+
+
+# -- issue 54, 1: a second plugin advertising a name another holds is left out, and the model spawns -------------
+VACUUM_ROBOT = """<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
+  </inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <gazebo><plugin name="vacuum" filename="libgazebo_ros_vacuum_gripper.so"><robotNamespace>/vac1</robotNamespace>
+    <bodyName>base</bodyName><topicName>grasping</topicName></plugin></gazebo>
+</robot>"""
+
+
+def test_a_second_vacuum_gripper_in_one_namespace_is_left_out_and_the_first_serves(env, bridge, tmp_path):
+    """It was refused with the raw 'service [/vac1/on] already registered'."""
+    try:
+        for name, y in (("vac_a", 3), ("vac_b", -3)):
+            result = spawn(env, tmp_path, name, VACUUM_ROBOT, "-x", "3", "-y", str(y))
+            assert result.returncode == 0, result.stdout + result.stderr
+        wait_until(lambda: "of model 'vac_b' is left out" in open(bridge.log_path).read(), 10, "the warning")
+        line = one_line(open(bridge.log_path).read(), "[WARN]", "plugin 'vacuum' (libgazebo_ros_vacuum_gripper.so) "
+                        "of model 'vac_b' is left out: it would advertise service '/vac1/on', which plugin 'vacuum' "
+                        "(libgazebo_ros_vacuum_gripper.so) of model 'vac_a' already advertises")
+        assert "\n" not in line
+        call_service(env, "/vac1/on", "{}", CALL_TIMEOUT)  # the first gripper answers (a failed call raises)
+    finally:
+        for name in ("vac_a", "vac_b"):
+            call(env, "delete_model", f"{{model_name: {name}}}")
+    assert_still_serving(env, bridge)
+
+
+# -- issue 54, 1 and 6: two link attachers in a world load one; a second /gazebo ends the first cleanly ------------
+def test_two_link_attachers_load_one_and_a_second_gazebo_ends_the_first_cleanly(ros_env, tmp_path):
+    """The world killed the node at start-up; a second /gazebo on the master ended the first with a TypeError in
+    the loop's publish and exit status 1."""
+    world = tmp_path / "two_attachers.world"
+    attacher = "<plugin name='{}' filename='libgazebo_ros_link_attacher.so'/>"
+    world.write_text(f"<sdf version='1.6'><world name='w'>{attacher.format('first')}{attacher.format('second')}"
+                     "</world></sdf>")
+    log_path = tmp_path / "roslaunch.log"
+    with open(log_path, "w") as log:
+        process = subprocess.Popen(["roslaunch", "mbot_sim_bridge", "empty_world.launch", "gui:=false",
+                                    f"world_name:={world}", "server_required:=true"], env=ros_env, stdout=log,
+                                   stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        wait_until(lambda: call_service(ros_env, "/gazebo/get_world_properties", "{}", CALL_TIMEOUT)["sim_time"] > 0,
+                   CALL_TIMEOUT, "the simulation to run")
+        run([sys.executable, "-c", "import rospy; rospy.init_node('gazebo', disable_signals=True)"], ros_env)
+        process.wait(CALL_TIMEOUT)
+    finally:
+        stop_process_group(process)
+    output = open(log_path).read()
+    one_line(output, "[WARN]", "plugin 'second' (libgazebo_ros_link_attacher.so) of world 'w' is left out: it would "
+             "advertise service '/link_attacher_node/attach', which plugin 'first'")
+    one_line(output, "[WARN]", "the simulator stops", "new node registered with same name")
+    assert "REQUIRED process [gazebo-1] has died!\nprocess has finished cleanly" in output, output
+
+
 def test_calls_during_a_long_step_are_carried_out_and_answered_at_once(env, bridge, monkeypatch):
     """The loop serves other calls between the batches of a step_simulation: each is carried out and answered
     while the step goes on (before, they failed after 30 s with an empty text and ran afterwards); a second

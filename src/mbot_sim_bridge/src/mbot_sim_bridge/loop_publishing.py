@@ -11,7 +11,9 @@ This takes over the part of rospy's ``_PublisherImpl.publish`` that serializes a
 header.seq, the length prefix, statistics), for publishers that are neither latched nor queued; a rospy
 Publisher has no hook for writing elsewhere.
 """
+import contextlib
 import errno
+import io
 import socket
 import struct
 import subprocess
@@ -49,6 +51,7 @@ class LoopPublishing:
         theirs.close()
         self._channel = ours
         self._batch = bytearray()
+        self._buffer = io.BytesIO()
         self._ids: Dict[object, Tuple[int, object]] = {}  # rospy connection -> (id, its publisher impl)
         self._connections: Dict[int, object] = {}
         self._next_id = 0
@@ -61,11 +64,12 @@ class LoopPublishing:
         self._lock = threading.RLock()
 
     def publish(self, impl, message):
-        with impl.publock, self._lock:
+        with self._impl_lock(impl), self._lock:
             connections = self._open_connections(impl)
             if not connections:
                 return
-            buffer = impl.buff
+            # The batch's own buffer, not the impl's: rospy's shutdown closes that from another thread.
+            buffer = self._buffer
             impl.seq += 1
             serialize_message(buffer, impl.seq, message)
             data = buffer.getvalue()
@@ -75,13 +79,19 @@ class LoopPublishing:
 
     def publish_records(self, impl, records: np.ndarray):
         """Messages serialized as numpy records (``length`` prefix first, header ``seq`` to fill), in one piece."""
-        with impl.publock, self._lock:
+        with self._impl_lock(impl), self._lock:
             connections = self._open_connections(impl)
             if not connections or not len(records):
                 return
             records["seq"] = np.arange(impl.seq + 1, impl.seq + 1 + len(records))
             impl.seq += len(records)
             self._append(impl, connections, records.tobytes(), len(records))
+
+    @staticmethod
+    def _impl_lock(impl):
+        """The publisher's lock; a publisher rospy has closed (its shutdown runs in another thread, when the master
+        hands the node's name to a new node) has none left, and takes no messages, as rospy's own publish."""
+        return impl.publock or contextlib.nullcontext()
 
     @staticmethod
     def _open_connections(impl) -> list:
@@ -211,7 +221,7 @@ class LoopPublishing:
         if connection is None:
             return
         _, impl = self._ids.pop(connection)
-        with impl.publock:
+        with self._impl_lock(impl):
             connection.close()  # rospy's cleanup callback removes it from the topic, as after a failed write
 
     def close(self):

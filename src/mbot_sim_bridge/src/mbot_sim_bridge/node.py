@@ -270,6 +270,9 @@ def main():
     sys.setswitchinterval(0.001)
     verbose = "--verbose" in rospy.myargv(sys.argv)[1:]
     init_node("gazebo", log_level=rospy.DEBUG if verbose else rospy.INFO, disable_signals=True)
+    # A shutdown rospy starts from outside: the master's request when another node registers as /gazebo.
+    requested = []
+    rospy.core.add_preshutdown_hook(lambda reason: (requested.append(reason), stop.set()))
     try:
         node = SimBridgeNode()
     except BridgeError as error:
@@ -279,6 +282,9 @@ def main():
     end_start_up()
     try:
         node.run(stop)
+        if requested:
+            # One line, and exit status 0, as a rospy node that rospy.spin() returns from on that request.
+            rospy.logwarn(f"the simulator stops: {requested[0]}")
     except loop_publishing.WriterStopped as error:
         rospy.logfatal(str(error))
         sys.exit(1)

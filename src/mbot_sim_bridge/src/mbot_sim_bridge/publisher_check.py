@@ -36,7 +36,9 @@ def check_joint_state_publishers(own_node_name: str, namespaces: Iterable[str]) 
 
 
 def joint_states_topic(namespace: str) -> str:
-    return rosgraph.names.ns_join(rosgraph.names.make_global_ns(namespace or "/"), "joint_states")
+    """Where a robot in ``namespace`` has its joint states, resolved as its publisher's name is (any text: a name
+    rospy cannot resolve must not end the check)."""
+    return rospy.resolve_name(rosgraph.names.ns_join(namespace or "/", "joint_states"))
 
 
 def describe(message: JointState) -> str:
@@ -83,11 +85,18 @@ class _PublisherCheck:
 
     def _check(self, own_node_name: str, namespaces: Tuple[str, ...]):
         try:
+            self._check_once(own_node_name, namespaces)
+        except Exception as error:  # whatever the names or the master do, the next call checks again
+            rospy.logwarn_once(f"joint_states check: {type(error).__name__}: {error}; checking goes on")
+        finally:
+            with self._lock:
+                self._busy = False
+
+    def _check_once(self, own_node_name: str, namespaces: Tuple[str, ...]):
+        try:
             publishers = dict(rosgraph.Master(own_node_name).getSystemState()[0])
         except Exception as error:  # the master gone or slow: the next call tries again
             rospy.logdebug(f"joint_states check: master query failed: {error}")
-            with self._lock:
-                self._busy = False
             return
         now = time.monotonic()
         with self._lock:
@@ -106,7 +115,6 @@ class _PublisherCheck:
                 if now - first_seen > SAMPLE_SECONDS:
                     self._report(key, f"no message from it arrived within {SAMPLE_SECONDS:.0f} s")
             self._drop_idle_samplers()
-            self._busy = False
 
     def _on_sample(self, message: JointState, topic: str):
         key = (topic, message._connection_header.get("callerid", ""))

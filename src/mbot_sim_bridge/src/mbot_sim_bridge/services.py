@@ -42,7 +42,7 @@ from .model_states import LinkStatesPublisher, ModelStatesPublisher
 from .package_uris import resolve_package_uris
 from .performance_metrics import PerformanceMetricsPublisher
 from .physics_reconfigure import PhysicsReconfigure
-from .plugins import ros_time
+from .plugins import namespace_complaint, ros_time
 from .subscriptions import drain
 from .world_saving import SaveWorldHandler
 
@@ -159,6 +159,10 @@ class GazeboRosApi:
         if request.model_name in self.sim.model_names():
             raise ModelError(f"SpawnModel: Failure - entity already exists: {request.model_name}")
         check_model_name("SpawnModel", request.model_name)
+        complaint = namespace_complaint(request.robot_namespace)
+        if complaint:
+            raise ModelError(f"SpawnModel: robot_namespace '{request.robot_namespace}' {complaint}; nothing was "
+                             "spawned")
         requested = _pose_from_message(request.initial_pose)
         # Checked as sent too: composed with the reference frame, 1e300 would turn inf and NaN and be named so.
         check_state(f"SpawnModel: model '{request.model_name}'", requested)

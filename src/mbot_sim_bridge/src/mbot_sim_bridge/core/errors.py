@@ -9,6 +9,11 @@ class ConfigError(BridgeError):
     """A <gazebo> block, plugin tag, launch argument or parameter is wrong."""
 
 
+class PluginLeftOut(BridgeError):
+    """A plugin that cannot run beside another (both would advertise one ROS name): left out with one warning
+    naming both, and the model or world goes on without it."""
+
+
 class ModelError(BridgeError):
     """A robot_description or model XML cannot be turned into a simulated model."""
 

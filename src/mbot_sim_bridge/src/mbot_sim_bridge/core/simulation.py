@@ -18,7 +18,7 @@ import pybullet
 from .added_plugins import ADDED_JOINT_STATE_RATE, joint_state_blocks, mimic_blocks
 from .body_wrenches import WORLD_FRAMES, BodyWrenches, requested_job
 from .engine import Engine, StepFault, check_state, frame_velocity
-from .errors import ConfigError, ModelError
+from .errors import ConfigError, ModelError, PluginLeftOut
 from .geometry import IDENTITY, Pose, Vector, compose, inverse, rotate
 from . import entity_properties, physics_properties
 from .entity_properties import JointProperties, LinkProperties
@@ -514,7 +514,7 @@ class Simulation:
         return missing
 
     def _build_plugins(self, spawned: SpawnedModel) -> List[Plugin]:
-        plugins: List[Plugin] = []
+        plugins = spawned.plugins  # filled in place: a spawn refused half-way closes those built so far
         model = spawned.robot.model
         for element in model.plugins:
             plugins.extend(self._create_plugin(spawned, element, None, None))
@@ -557,7 +557,11 @@ class Simulation:
             raise ConfigError(f"{where}: model '{spawned.name}': {filename} needs <sensor type=\"{wanted}\">, but "
                               f"sensor '{sensor.get('name')}' has type \"{sensor.get('type')}\"")
         context = PluginContext(self, spawned, link_name)
-        return [plugin_class(context, element, sensor)]
+        try:
+            return [plugin_class(context, element, sensor)]
+        except PluginLeftOut as error:  # a name another plugin holds: the model goes on without this one
+            _logger.warning(f"{where}: {error}")
+            return []
 
     def _create_world_plugin(self, element: ElementTree.Element) -> List[Plugin]:
         """A ``<plugin>`` of the world, as Gazebo loads one: an unknown or model plugin is said once and left
@@ -572,6 +576,9 @@ class Simulation:
             return [plugin_class(WorldPluginContext(self, self.world_plugins, path=self.world.path), element)]
         except ConfigError as error:
             _logger.error(f"{where}: plugin '{element.get('name')}' ({filename}) not loaded: {error}")
+            return []
+        except PluginLeftOut as error:
+            _logger.warning(f"{where}: {error}")
             return []
 
     def _schedule(self):

@@ -16,7 +16,6 @@ from controller_manager_msgs.srv import (ListControllers, ListControllersRespons
 from std_msgs.msg import Bool
 
 from ..core.ros_control.gazebo_ros_control import GazeboRosControlPlugin
-from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .ros_controllers import ROS_CONTROLLERS
 
@@ -31,8 +30,8 @@ class GazeboRosControl(RosPlugin, GazeboRosControlPlugin):
         super().__init__(context, element, sensor)
         prefix = resolve_in_namespace(self.namespace, "controller_manager") + "/"
         if self.params["eStopTopic"]:
-            self.topics.own(TrackedSubscriber(resolve_in_namespace(self.namespace, self.params["eStopTopic"]), Bool,
-                                              self._on_e_stop))
+            self.topics.subscriber(resolve_in_namespace(self.namespace, self.params["eStopTopic"]), Bool,
+                                   self._on_e_stop)
         handlers = (("list_controllers", ListControllers, self._list_controllers),
                     ("list_controller_types", ListControllerTypes, self._list_controller_types),
                     ("load_controller", LoadController, self._load_controller),
@@ -40,7 +39,7 @@ class GazeboRosControl(RosPlugin, GazeboRosControlPlugin):
                     ("switch_controller", SwitchController, self._switch_controller),
                     ("reload_controller_libraries", ReloadControllerLibraries, self._reload_libraries))
         for name, service_type, handler in handlers:
-            self.topics.own(rospy.Service(prefix + name, service_type, self._serialized(handler)))
+            self.topics.service(prefix + name, service_type, self._serialized(handler))
         joints = ", ".join(f"{name}: {joint.interface}" for name, joint in self.hw.joints.items())
         rospy.loginfo(f"{self.label}: controller manager in namespace {self.namespace}: {len(self.hw.joints)} joints "
                       f"({joints}), control period {self.control_period:.4f} s")

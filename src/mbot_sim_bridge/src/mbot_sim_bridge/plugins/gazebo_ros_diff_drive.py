@@ -7,7 +7,6 @@ from tf2_msgs.msg import TFMessage
 
 from ..core.drives.diff_drive import DiffDrive
 from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
-from ..subscriptions import TrackedSubscriber
 from ..core.names import resolve_frame, tf_prefix
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .ground_truth_odometry import on_twist
@@ -31,7 +30,7 @@ class GazeboRosDiffDrive(RosPlugin, DiffDrive):
                                                        JointState) if self.joint_states_published else None)
         self._make_messages()
         self.command_topic = resolve_in_namespace(self.namespace, params["commandTopic"])
-        topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
+        topics.subscriber(self.command_topic, Twist, lambda message: on_twist(self, message))
         if params["publishWheelTF"]:
             rospy.loginfo(f"{self.label}: publishWheelTF: the wheel frames reach /tf through robot_state_publisher "
                           "from joint_states; they are not broadcast a second time (that duplicate is what makes "

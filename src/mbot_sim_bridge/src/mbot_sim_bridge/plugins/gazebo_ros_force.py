@@ -3,7 +3,6 @@ import rospy
 from geometry_msgs.msg import Wrench
 
 from ..core.manipulation.force import Force
-from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
 
 
@@ -11,7 +10,7 @@ class GazeboRosForce(RosPlugin, Force):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         topic = resolve_in_namespace(self.robot_namespace(), self.params["topicName"])
-        self.topics.own(TrackedSubscriber(topic, Wrench, self._on_wrench))
+        self.topics.subscriber(topic, Wrench, self._on_wrench)
         rospy.loginfo(f"{self.label}: {topic} pushes link '{self.link}' (world frame, at its centre of mass)")
 
     def _on_wrench(self, message: Wrench):

@@ -15,8 +15,8 @@ class GazeboRosImu(RosPlugin, ImuModelPlugin):
         self.publisher = None
         if self.params["topicName"]:
             self.publisher = self.topics.publisher(resolve_in_namespace(namespace, self.params["topicName"]), Imu)
-            self.topics.own(rospy.Service(resolve_in_namespace(namespace, self.params["serviceName"]), Empty,
-                                          lambda request: EmptyResponse()))
+            self.topics.service(resolve_in_namespace(namespace, self.params["serviceName"]), Empty,
+                                lambda request: EmptyResponse())
         topic = self.publisher.resolved_name if self.publisher else "(no topicName: nothing)"
         rate = f"at {self.params['updateRate']:g} Hz" if self.params["updateRate"] else "at every physics step"
         rospy.loginfo(f"{self.label}: link '{self.link}' -> {topic} (frame '{self.frame_name}') {rate}")

@@ -13,9 +13,8 @@ class GazeboRosLinkAttacher(RosPlugin, LinkAttacher):
     def __init__(self, context, element, sensor=None):
         super().__init__(context, element, sensor)
         for verb, action in (("attach", self.attach), ("detach", self.detach)):
-            service = self.topics.own(rospy.Service(f"link_attacher_node/{verb}", Attach,
-                                                    lambda request, verb=verb, action=action:
-                                                    self._serve(request, verb, action)))
+            service = self.topics.service(f"link_attacher_node/{verb}", Attach,
+                                          lambda request, verb=verb, action=action: self._serve(request, verb, action))
             rospy.loginfo(f"{verb.capitalize()} service at: {service.resolved_name}")
         rospy.loginfo("Link attacher node initialized.")
 

@@ -5,7 +5,6 @@ from geometry_msgs.msg import Twist
 from ..core.names import resolve_frame, tf_prefix
 from ..core.drives.planar_move import PlanarMove
 from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
-from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
 from .ground_truth_odometry import OdometryOutput, on_twist
 
@@ -21,7 +20,7 @@ class GazeboRosPlanarMove(RosPlugin, PlanarMove):
         self.output = OdometryOutput(self.topics, resolve_in_namespace(namespace, params["odometryTopic"]),
                                      odom_frame, base_frame, ODOM_POSE_COVARIANCE, broadcast_tf=True)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
-        self.topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
+        self.topics.subscriber(self.command_topic, Twist, lambda message: on_twist(self, message))
         rospy.loginfo(f"{self.label}: {self.command_topic} sets the base's velocity; odometry on "
                       f"{self.output.odom_publisher.resolved_name} at {params['odometryRate']:g} Hz, TF {odom_frame} "
                       f"-> {base_frame}")

@@ -5,7 +5,6 @@ from geometry_msgs.msg import Twist
 
 from ..core.names import resolve_frame, tf_prefix
 from ..core.drives.skid_steer_drive import SkidSteerDrive
-from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace
 from .messages import diagonal_covariance
 from .ground_truth_odometry import OdometryOutput, on_twist
@@ -24,7 +23,7 @@ class GazeboRosSkidSteerDrive(RosPlugin, SkidSteerDrive):
                                      resolve_frame(params["robotBaseFrame"], prefix), covariance,
                                      params["broadcastTF"], twist_covariance=covariance)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
-        self.topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
+        self.topics.subscriber(self.command_topic, Twist, lambda message: on_twist(self, message))
         rospy.loginfo(f"{self.label}: {self.command_topic} -> wheels {', '.join(self.joints)}, separation "
                       f"{params['wheelSeparation']:.3f} m, diameter {params['wheelDiameter']:.3f} m, torque "
                       f"{params['torque']:.1f} N·m; odometry on {self.output.odom_publisher.resolved_name} at "

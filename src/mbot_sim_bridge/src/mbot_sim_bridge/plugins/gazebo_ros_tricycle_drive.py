@@ -7,7 +7,6 @@ from sensor_msgs.msg import JointState
 from ..core.names import resolve_frame, tf_prefix
 from ..core.drives.tricycle_drive import TricycleDrive
 from ..core.drives.twist_drive import ODOM_POSE_COVARIANCE
-from ..subscriptions import TrackedSubscriber
 from . import RosPlugin, resolve_in_namespace, ros_time
 from .ground_truth_odometry import OdometryOutput, on_twist
 
@@ -26,7 +25,7 @@ class GazeboRosTricycleDrive(RosPlugin, TricycleDrive):
                                                             JointState)
                                       if params["publishWheelJointState"] else None)
         self.command_topic = resolve_in_namespace(namespace, params["commandTopic"])
-        self.topics.own(TrackedSubscriber(self.command_topic, Twist, lambda message: on_twist(self, message)))
+        self.topics.subscriber(self.command_topic, Twist, lambda message: on_twist(self, message))
         if params["publishWheelTF"]:
             rospy.loginfo(f"{self.label}: publishWheelTF: the joints' frames reach /tf through robot_state_publisher "
                           "from joint_states; they are not broadcast a second time")

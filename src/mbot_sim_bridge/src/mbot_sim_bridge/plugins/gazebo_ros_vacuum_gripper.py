@@ -12,8 +12,8 @@ class GazeboRosVacuumGripper(RosPlugin, VacuumGripper):
         super().__init__(context, element, sensor)
         namespace = self.robot_namespace()
         self.publisher = self.topics.publisher(resolve_in_namespace(namespace, self.params["topicName"]), Bool)
-        self.services = [rospy.Service(resolve_in_namespace(namespace, name), Empty,
-                                       lambda request, on=on: self._on_switch(on))
+        self.services = [self.topics.service(resolve_in_namespace(namespace, name), Empty,
+                                             lambda request, on=on: self._on_switch(on))
                          for name, on in (("on", True), ("off", False))]
         rospy.loginfo(f"{self.label}: link '{self.link}' pulls while on ({self.services[0].resolved_name}, "
                       f"{self.services[1].resolved_name}); {self.publisher.resolved_name} says whether it grasps")
@@ -28,8 +28,3 @@ class GazeboRosVacuumGripper(RosPlugin, VacuumGripper):
             return
         super().update(now)
         self.publisher.publish(Bool(self.grasping))
-
-    def close(self):
-        super().close()
-        for service in self.services:
-            service.shutdown()

@@ -37,7 +37,7 @@ class HectorGazeboRosImu(RosPlugin, HectorImu):
         self.bias_publisher = (self.topics.publisher(resolve_in_namespace(namespace, bias_topic), Imu)
                                if bias_topic else None)
         if service:
-            self.topics.own(rospy.Service(resolve_in_namespace(namespace, service), Empty, self._calibrate))
+            self.topics.service(resolve_in_namespace(namespace, service), Empty, self._calibrate)
         info_once(_logger, f"{self.label}: the set_accel_bias/set_rate_bias services and dynamic_reconfigure "
                                     "need hector_gazebo_plugins' own types and are not provided")
         shown = self.publisher.resolved_name if self.publisher else "(no topicName: nothing)"
