@@ -6,24 +6,33 @@ in the empty world as a Python scenario and as a rostest file, and a box slides 
 - a real two-node cluster (``dask scheduler`` and two ``dask worker`` processes, each in its own process group),
   one worker killed while it runs a run: the run is rescheduled and each of the 12 results equals the embedded
   one;
-- a hanging run killed at its timeout, retried, reported with its log tail;
+- a second batch into the folder of one that runs is refused, and changes nothing;
+- a hanging run killed at its timeout with its hostile children (one ignoring SIGTERM, one started with a clean
+  environment, a double-forked orphan), retried, reported with its log tail;
 - the rostest scenario's runs of that batch: their test cases' verdict and their metrics;
-- a failing run rerun with ``mbot batch rerun``: its metrics come out bit-identical;
+- a failing run rerun with ``mbot batch rerun``: its metrics, read from its log, come out bit-identical, and a
+  batch metric changed by one ulp is reported as DIFFERS with exit status 1;
 - the report page's figures in a headless Chromium screenshot.
 """
 import json
+import math
 import os
+import re
 import shutil
 import signal
 import subprocess
 import sys
 import time
+import uuid
 
 import pytest
-from mbot_batch.engine import batch_token
+from mbot_batch.engine import folder_token
 from mbot_batch.results import load_result
 from mbot_batch.run import processes_with_token
 from ros_processes import wait_until
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios"))
+from hang import HOSTILE_CHILDREN  # noqa: E402 - the scenarios' folder is no package
 
 pytestmark = pytest.mark.long
 
@@ -44,15 +53,6 @@ def start_batch(out, *options, spec=SPEC):
                                 preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
-def batch_to_its_end(out, spec, workers):
-    """The batch's exit status."""
-    driver = start_batch(out, "--workers", str(workers), spec=spec)
-    try:
-        return driver.wait(timeout=BATCH_TIMEOUT)
-    finally:
-        stop_group(driver)
-
-
 def finished(out):
     folder = os.path.join(out, "runs")
     return {run_id for run_id in (os.listdir(folder) if os.path.isdir(folder) else ())
@@ -69,8 +69,34 @@ SCAN_INTERVAL = 0.2
 
 
 def assert_no_run_processes(out, timeout=3.0):
-    wait_until(lambda: not processes_with_token(batch_token(out)), timeout, f"the runs of {out} to be gone",
+    wait_until(lambda: not processes_with_token(folder_token(out)), timeout, f"the runs of {out} to be gone",
                interval=SCAN_INTERVAL)
+
+
+def processes_named(marker):
+    """Live processes whose command line holds ``marker`` (found without their environment)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/cmdline", "rb") as stream:
+                named = marker.encode() in stream.read().split(b"\0")
+            with open(f"/proc/{entry}/stat") as stream:
+                alive = stream.read().rsplit(")", 1)[1].split()[0] != "Z"
+        except (OSError, IndexError):
+            continue  # not a process, or gone
+        if named and alive:
+            found.append(int(entry))
+    return found
+
+
+def snapshot(folder):
+    """Every file under ``folder`` with its bytes."""
+    files = {}
+    for root, _, names in os.walk(folder):
+        for name in names:
+            with open(os.path.join(root, name), "rb") as stream:
+                files[os.path.relpath(os.path.join(root, name), folder)] = stream.read()
+    return files
 
 
 def scheduling_policies(pids):
@@ -107,14 +133,20 @@ def embedded(tmp_path_factory):
 
         driver = start_batch(out, "--workers", "1")
         # The run process and a process it started (after it set its policy, which they inherit).
-        wait_until(lambda: len(processes_with_token(batch_token(out))) >= 2, 60, "a resumed run to be running",
+        wait_until(lambda: len(processes_with_token(folder_token(out))) >= 2, 60, "a resumed run to be running",
                    interval=SCAN_INTERVAL)
-        seen["policies"] = scheduling_policies(processes_with_token(batch_token(out)))
+        seen["policies"] = scheduling_policies(processes_with_token(folder_token(out)))
+        # A second batch into the same folder meanwhile: refused before it writes anything.
+        before = {name: data for name, data in snapshot(out).items() if not name.startswith("runs")}
+        second = subprocess.run([sys.executable, BATCH, SPEC, "-o", out, "--quiet"], capture_output=True, text=True,
+                                timeout=60)
+        seen["second batch"] = (second.returncode, second.stderr, before,
+                                {name: data for name, data in snapshot(out).items() if not name.startswith("runs")})
         interrupted = time.monotonic()
         os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the driver and its workers
         seen["ctrl-c exit"] = driver.wait(timeout=30)
         seen["ctrl-c seconds"] = time.monotonic() - interrupted
-        seen["left after ctrl-c"] = processes_with_token(batch_token(out))
+        seen["left after ctrl-c"] = processes_with_token(folder_token(out))
         seen["after ctrl-c"] = result_files(out)
 
         driver = start_batch(out)  # the embedded default: a worker per core
@@ -133,6 +165,11 @@ def test_a_killed_or_interrupted_driver_resumes_and_skips_finished_runs(embedded
     for stage in ("after kill", "after ctrl-c"):
         assert {run_id: final[run_id] for run_id in seen[stage]} == seen[stage], f"a run finished {stage} ran again"
     assert seen["policies"] == {os.SCHED_BATCH}, "a run's processes are batch tasks"
+    status, message, before, after = seen["second batch"]
+    assert status == 2 and message.count("\n") == 1, message
+    assert re.fullmatch(rf"mbot batch: {re.escape(out)} is in use by another batch \(pid \d+ on .+ since .+\): "
+                        r"wait for it to end, or give another -o\n", message), message
+    assert after == before, "the refused batch changed the folder"
     assert seen["ctrl-c exit"] == 130
     print(f"figure: batch: Ctrl-C to the driver's exit {seen['ctrl-c seconds']:.1f} s, no run process left")
     assert seen["ctrl-c seconds"] < CTRL_C_SECONDS
@@ -185,7 +222,7 @@ def test_a_two_node_cluster_gives_the_embedded_results_and_reschedules_a_killed_
     driver = start_batch(out, "--address", address)
     try:
         def doomed_run():
-            for pid in processes_with_token(batch_token(out)):
+            for pid in processes_with_token(folder_token(out)):
                 try:
                     if os.getpgid(_parent(pid)) == doomed.pid:
                         return _token(pid).split(":")[1]
@@ -221,12 +258,23 @@ def _token(pid):
 
 def test_a_hanging_run_is_killed_at_its_timeout_retried_and_reported_with_its_log_tail(tmp_path):
     spec = tmp_path / "hang.yaml"
+    marker = f"mbot-batch-test-child-{uuid.uuid4().hex[:8]}"
     # The simulator alone (no robot to describe and spawn): what hangs is the scenario.
     spec.write_text("scenarios:\n  hang:\n    launch: gazebo_ros empty_world.launch\n    python: hang.py\n"
-                    "matrix:\n  seed: [0]\ntimeout: 8\nretries: 1\n")
+                    f"matrix:\n  seed: [0]\n  marker: [{marker}]\ntimeout: 8\nretries: 1\n")
     shutil.copy(os.path.join(HERE, "scenarios", "hang.py"), tmp_path)
     out = str(tmp_path / "out")
-    assert batch_to_its_end(out, str(spec), workers=1) == 1
+    driver = start_batch(out, "--workers", "1", spec=str(spec))
+    try:
+        wait_until(lambda: len(processes_named(marker)) == HOSTILE_CHILDREN, 60, "the hanging run's children",
+                   interval=SCAN_INTERVAL)
+        assert driver.wait(timeout=BATCH_TIMEOUT) == 1
+        # None outlived its run, the clean environment's and the orphan's included.
+        assert processes_named(marker) == []
+    finally:
+        stop_group(driver)
+        for pid in processes_named(marker):
+            os.kill(pid, signal.SIGKILL)
     (run_id,) = finished(out)
     result = load_result(out, run_id)
     assert result["status"] == "timeout" and result["attempts"] == 2, result
@@ -248,15 +296,35 @@ def test_a_rostest_scenario_counts_its_test_cases_and_metrics(embedded):
     assert verdicts == [(False, "failed", "rostest: 1 of 1 test cases failed")] * 2 + [(True, "passed", "")] * 2
 
 
-def test_rerunning_a_failing_run_reproduces_its_metrics_bit_identically(embedded):
-    out, _ = embedded
-    failing = sorted(run_id for run_id in finished(out) if load_result(out, run_id)["status"] == "failed")
+def test_rerunning_a_failing_run_reproduces_its_metrics_bit_identically_and_reports_a_differing_one(embedded,
+                                                                                                    tmp_path):
+    """One rerun, of a copy of the batch's folder in which one recorded metric is one ulp off: the rerun's own
+    metrics (its log's lines, read here) equal the batch's bit for bit, and the changed one must be reported."""
+    reference, _ = embedded
+    failing = sorted(run_id for run_id in finished(reference) if load_result(reference, run_id)["status"] == "failed"
+                     and load_result(reference, run_id)["scenario"] == "drive")
     assert failing
-    rerun = subprocess.run([sys.executable, BATCH, "rerun", out, failing[0]], capture_output=True, text=True,
+    run_id = failing[0]
+    out = str(tmp_path / "out")
+    shutil.copytree(os.path.join(reference, "runs", run_id), os.path.join(out, "runs", run_id))
+    result_file = os.path.join(out, "runs", run_id, "result.json")
+    with open(result_file) as stream:
+        recorded = json.load(stream)
+    changed = sorted(recorded["metrics"])[0]
+    recorded["metrics"][changed] = math.nextafter(recorded["metrics"][changed], math.inf)
+    with open(result_file, "w") as stream:
+        json.dump(recorded, stream)
+    rerun = subprocess.run([sys.executable, BATCH, "rerun", out, run_id], capture_output=True, text=True,
                            timeout=120)
-    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
-    assert "status: failed" in rerun.stdout and "metrics bit-identical to the batch's" in rerun.stdout
-    assert os.path.exists(os.path.join(out, "reruns", failing[0], "scenario.log"))
+    assert rerun.returncode == 1, rerun.stdout + rerun.stderr
+    assert "status: failed" in rerun.stdout and "metrics differ from the batch's" in rerun.stdout
+    verdicts = dict(re.findall(r"^  (\S+): .* (bit-identical|DIFFERS)$", rerun.stdout, re.MULTILINE))
+    assert verdicts == {name: "DIFFERS" if name == changed else "bit-identical" for name in recorded["metrics"]}
+    with open(os.path.join(out, "reruns", run_id, "scenario.log")) as stream:
+        rerun_metrics = dict(re.findall(r"^metric (\S+) (\S+)$", stream.read(), re.MULTILINE))
+    batch_metrics = load_result(reference, run_id)["metrics"]
+    assert {name: float(value).hex() for name, value in rerun_metrics.items()} == \
+        {name: float(value).hex() for name, value in batch_metrics.items()}
 
 
 def test_the_report_shows_its_figures_in_a_browser(embedded, tmp_path):

@@ -5,13 +5,20 @@ import os
 import sys
 
 from . import engine, launch_files, spec
-from .results import load_result, load_run, run_folder, verdict
+from .results import load_result, load_run, run_folder, verdict, write_text
 
 
 def main(argv=None):
+    """The exit status: 130 on Ctrl-C at any point (the spec's check, the runs, the summary, the report)."""
     argv = sys.argv[1:] if argv is None else argv
-    if argv and argv[0] == "rerun":
-        return rerun(argv[1:])
+    try:
+        return rerun(argv[1:]) if argv and argv[0] == "rerun" else batch(argv)
+    except KeyboardInterrupt:
+        print("mbot batch: interrupted", file=sys.stderr)
+        return 130
+
+
+def batch(argv):
     parser = argparse.ArgumentParser(prog="mbot batch", description="Run a spec's seeded scenario batch on Dask "
                                      "distributed (./mbot batch rerun OUT RUN_ID replays one run).")
     parser.add_argument("spec", help="the batch spec (YAML)")
@@ -23,12 +30,16 @@ def main(argv=None):
     if args.workers is not None and args.workers < 1:
         parser.error("--workers must be at least 1")
     try:
-        batch = spec.load(args.spec, launch_files.resolve)
+        checked = spec.load(args.spec, launch_files.resolve)
     except spec.SpecError as error:
         print(f"mbot batch: {error}", file=sys.stderr)
         return 2
-    out = args.out or os.path.join("out", "batch", batch.name)
-    return engine.run_batch(batch, out, address=args.address, workers=args.workers, quiet=args.quiet)
+    out = args.out or os.path.join("out", "batch", checked.name)
+    try:
+        return engine.run_batch(checked, out, address=args.address, workers=args.workers, quiet=args.quiet)
+    except engine.FolderInUse as error:
+        print(f"mbot batch: {error}", file=sys.stderr)
+        return 2
 
 
 def rerun(argv):
@@ -46,16 +57,10 @@ def rerun(argv):
     run = load_run(args.out, args.run_id)
     print(f"mbot batch rerun: {run.run_id} ({recorded['status']} in the batch)", file=sys.stderr, flush=True)
     options = [flag for flag, wanted in (("--gui", args.gui), ("--rviz", args.rviz)) if wanted]
-    try:
-        raw = engine.execute_run(run.to_dict(), engine.batch_token(args.out) + "-rerun", options)
-    except KeyboardInterrupt:
-        print("mbot batch rerun: interrupted", file=sys.stderr)
-        return 130
+    raw = engine.execute_run(run.to_dict(), engine.batch_token(args.out), options)
     folder = os.path.join(args.out, "reruns", run.run_id)
-    os.makedirs(folder, exist_ok=True)
     for name, text in raw.pop("logs").items():
-        with open(os.path.join(folder, name), "w") as stream:
-            stream.write(text)
+        write_text(os.path.join(folder, name), text)
     checks = {check["metric"]: spec.Check(check["min"], check["max"]) for check in recorded["checks"]}
     outcome = verdict(raw, checks)
     print(f"status: {outcome['status']}" + (f" ({outcome['reason']})" if outcome["reason"] else ""))

@@ -1,22 +1,28 @@
 """The batch's report page: one static HTML file with its matplotlib figures embedded (PNG, base64), free of ROS.
 
-Pass rate per value of each matrix key, the distribution of each metric (its check's bounds drawn), the failing
-runs with their ids, reasons and log tails, and the slowest runs."""
+Pass rate per value of each matrix key, the distribution of each metric (its check's bounds drawn; values it cannot
+draw, not finite or past matplotlib's range, listed below it), the failing runs with their ids, reasons and log
+tails, and the slowest runs."""
 import base64
 import html
 import io
 from collections import defaultdict
 from typing import Dict, List
 
+from .results import finite, write_text
 from .spec import Run
 
 SLOWEST = 10
 FIGURE_WIDTH = 9.0
+BINS = 20
+# matplotlib's axes overflow on values of about 1e308 (their span is not a float); a histogram of such values is
+# not drawn but listed.
+DRAWABLE = 1e300
 
 
 def write(path: str, title: str, runs: List[Run], results: Dict[str, dict], wall_seconds: float = None):
-    with open(path, "w") as stream:
-        stream.write(page(title, runs, results, wall_seconds))
+    """Rendered first, then put in place whole: an interrupted report leaves the earlier one."""
+    write_text(path, page(title, runs, results, wall_seconds))
 
 
 def page(title: str, runs: List[Run], results: Dict[str, dict], wall_seconds: float = None) -> str:
@@ -37,6 +43,14 @@ def page(title: str, runs: List[Run], results: Dict[str, dict], wall_seconds: fl
              f"<h1>{_e(title)}</h1><p>{len(done)} of {len(runs)} runs finished: {_e(summary) or 'none'}{timing}.</p>"]
     parts += [f"<h2>{_e(caption)}</h2><img alt='{_e(caption)}' src='data:image/png;base64,{image}'>"
               for caption, image in figures]
+    undrawn = [(run, name, value) for run in done for name, value in sorted(results[run.run_id]["metrics"].items())
+               if value is not None and not _drawable(value)]
+    if undrawn:
+        parts.append(f"<h2>Metrics not drawn ({len(undrawn)})</h2><p>Not finite, or beyond &plusmn;{DRAWABLE:g}."
+                     "</p><table><tr><th>run id</th><th>metric</th><th>value</th><th>status</th></tr>")
+        parts += [f"<tr><td><code>{_e(run.run_id)}</code></td><td>{_e(name)}</td><td>{_e(value)}</td>"
+                  f"<td>{_e(results[run.run_id]['status'])}</td></tr>" for run, name, value in undrawn]
+        parts.append("</table>")
     parts.append(f"<h2>Failing runs ({len(failing)})</h2>")
     if failing:
         parts.append("<table><tr><th>run id</th><th>status</th><th>reason</th><th>matrix</th><th>log tail</th></tr>")
@@ -55,7 +69,7 @@ def page(title: str, runs: List[Run], results: Dict[str, dict], wall_seconds: fl
         result = results[run.run_id]
         sim = result.get("sim_seconds")
         parts.append(f"<tr><td><code>{_e(run.run_id)}</code></td><td>{result['wall_seconds']:.1f}</td>"
-                     f"<td>{'' if sim in ('', None) else f'{sim:.1f}'}</td><td>{result['status']}</td>"
+                     f"<td>{f'{sim:.1f}' if finite(sim) else _e(sim)}</td><td>{result['status']}</td>"
                      f"<td>{_e(result.get('worker', ''))}</td></tr>")
     parts.append("</table></body></html>\n")
     return "\n".join(parts)
@@ -114,17 +128,36 @@ def _metric_distributions(runs: List[Run], results: Dict[str, dict]):
     for axis in axes.flat[len(names):]:
         axis.set_visible(False)
     for axis, name in zip(axes.flat, names):
-        values = [results[run.run_id]["metrics"][name] for run in runs
-                  if isinstance(results[run.run_id]["metrics"].get(name), float)]
-        axis.hist(values, bins=20, color="#48c")
+        values = [float(results[run.run_id]["metrics"][name]) for run in runs
+                  if _drawable(results[run.run_id]["metrics"].get(name))]
+        if values:
+            axis.hist(values, bins=_bin_edges(values), color="#48c")
         bounds = {bound for run in runs for check in results[run.run_id]["checks"] if check["metric"] == name
-                  for bound in (check["min"], check["max"]) if bound is not None}
+                  for bound in (check["min"], check["max"]) if _drawable(bound)}
         for bound in bounds:
             axis.axvline(bound, color="#c33", linestyle="--")
         axis.set_title(name, fontsize=10)
         axis.set_ylabel("runs")
     figure.tight_layout()
     return "Metric distributions", _png(figure)
+
+
+def _drawable(value) -> bool:
+    return finite(value) and abs(value) <= DRAWABLE
+
+
+def _bin_edges(values: List[float]):
+    """numpy's default bins overflow on a span below about 1e-307 (bins per unit) and on one value of 1e300 (it
+    widens it by 0.5); these edges are interpolated without taking the span, and a single value gets a bin of its
+    own size around it."""
+    import numpy
+    low, high = min(values), max(values)
+    steps = numpy.linspace(0.0, 1.0, BINS + 1)
+    edges = numpy.unique(low * (1 - steps) + high * steps)
+    if len(edges) < 2:
+        half = max(0.5, abs(low) * 1e-3)
+        edges = numpy.array([low - half, low + half])
+    return edges
 
 
 def _e(text) -> str:

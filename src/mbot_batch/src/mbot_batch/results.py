@@ -6,9 +6,11 @@ A run's verdict comes from what its run process saw (``raw``: exit status, metri
 counts) and the scenario's checks."""
 import csv
 import json
+import math
 import os
 import re
 import tempfile
+from contextlib import contextmanager
 from typing import Dict, List, Optional
 from xml.etree import ElementTree
 
@@ -35,6 +37,19 @@ def parse_metrics(text: str) -> Dict[str, float]:
     return metrics
 
 
+def recorded(value):
+    """A metric as result.json and metrics.json hold it: strict JSON has no NaN or infinities, so those are the texts
+    "nan", "inf" and "-inf" (``float()`` reads them back); a finite value as it is."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return repr(value)
+    return value
+
+
+def finite(value) -> bool:
+    """A metric a figure can draw: a finite number (not a recorded "nan", "inf" or "-inf", nor a missing one)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def log_tail(text: str, lines: int = LOG_TAIL_LINES) -> str:
     return "\n".join(text.rstrip("\n").splitlines()[-lines:])
 
@@ -45,7 +60,7 @@ def verdict(raw: dict, checks: Dict[str, Check]) -> dict:
     ``rostest`` ({tests, failed}). ``completed``: the scenario ran to its end (and rostest's cases passed), so
     that only the checks can have failed."""
     metrics = raw.get("metrics") or {}
-    results = [{"metric": name, "value": metrics.get(name), "bounds": check.describe(), "min": check.minimum,
+    results = [{"metric": name, "value": recorded(metrics.get(name)), "bounds": check.describe(), "min": check.minimum,
                 "max": check.maximum, "passed": metrics.get(name) is not None and check.passes(metrics[name])}
                for name, check in checks.items()]
 
@@ -63,32 +78,60 @@ def verdict(raw: dict, checks: Dict[str, Check]) -> dict:
     bad = [name for name, value in metrics.items() if value is None]
     if bad:
         return outcome(ERROR, f"metric '{bad[0]}' is not a number")
-    failing = [f"{check['metric']} = {'missing' if check['value'] is None else format(check['value'], 'g')}, "
+    failing = [f"{check['metric']} = {'missing' if check['value'] is None else _text(check['value'])}, "
                f"wanted {check['bounds']}" for check in results if not check["passed"]]
+    # Deterministic like a check's verdict, so failed rather than an error to retry.
+    failing += [f"{name} = {value!r}, not a finite number" for name, value in metrics.items()
+                if name not in checks and not math.isfinite(value)]
     if failing:
         return outcome(FAILED, "; ".join(failing), completed=True)
     return outcome(PASSED, "", completed=True)
+
+
+def _text(value) -> str:
+    return format(value, "g") if isinstance(value, float) else str(value)
 
 
 def run_folder(out: str, run_id: str) -> str:
     return os.path.join(out, "runs", run_id)
 
 
+@contextmanager
+def replacing(path: str, mode: str = "w", **options):
+    """A stream into a temporary file beside ``path``, renamed onto it when the block ends well: a driver killed or
+    interrupted mid-write leaves the earlier file whole (no half report, no half result for the resume to trust)."""
+    folder = os.path.dirname(path) or "."
+    os.makedirs(folder, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(dir=folder, prefix=f".{os.path.basename(path)}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, mode, **options) as stream:
+            yield stream
+        os.replace(temporary, path)
+    except BaseException:
+        os.unlink(temporary)
+        raise
+
+
 def write_json(path: str, data):
-    """Written whole or not at all (a driver killed mid-write leaves no half file for the resume to trust)."""
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    handle, temporary = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".tmp")
-    with os.fdopen(handle, "w") as stream:
-        json.dump(data, stream, indent=1, sort_keys=True)
-    os.replace(temporary, path)
+    """Strict JSON (no NaN or infinities: ``recorded`` turns them into texts), written whole or not at all."""
+    with replacing(path) as stream:
+        json.dump(data, stream, indent=1, sort_keys=True, allow_nan=False)
+
+
+def write_text(path: str, text: str):
+    with replacing(path) as stream:
+        stream.write(text)
+
+
+def write_bytes(path: str, data: bytes):
+    with replacing(path, "wb") as stream:
+        stream.write(data)
 
 
 def write_attempt_logs(out: str, run_id: str, attempt: int, logs: Dict[str, str]) -> str:
     folder = os.path.join(run_folder(out, run_id), "logs", f"attempt-{attempt}")
-    os.makedirs(folder, exist_ok=True)
     for name, text in logs.items():
-        with open(os.path.join(folder, name), "w") as stream:
-            stream.write(text)
+        write_text(os.path.join(folder, name), text)
     return folder
 
 
@@ -97,8 +140,8 @@ def write_result(out: str, run: Run, result: dict):
     folder = run_folder(out, run.run_id)
     write_json(os.path.join(folder, "run.json"), run.to_dict())
     write_json(os.path.join(folder, "metrics.json"), result["metrics"])
-    ElementTree.ElementTree(junit(run, result)).write(os.path.join(folder, "junit.xml"), encoding="unicode",
-                                                      xml_declaration=True)
+    with replacing(os.path.join(folder, "junit.xml")) as stream:
+        ElementTree.ElementTree(junit(run, result)).write(stream, encoding="unicode", xml_declaration=True)
     write_json(os.path.join(folder, "result.json"), result)
 
 
@@ -145,7 +188,7 @@ def write_summary(path: str, runs: List[Run], results: Dict[str, dict]):
     columns of their own."""
     matrix_keys = sorted({key for run in runs for key in run.values})
     metric_names = sorted({name for result in results.values() for name in result["metrics"]})
-    with open(path, "w", newline="") as stream:
+    with replacing(path, newline="") as stream:
         writer = csv.writer(stream)
         writer.writerow([*SUMMARY_COLUMNS, *matrix_keys, *metric_names])
         for run in runs:

@@ -27,6 +27,7 @@ import hashlib
 import json
 import math
 import os
+import re
 from dataclasses import asdict, dataclass, field
 from itertools import product
 from typing import Callable, Dict, List, Optional, Tuple
@@ -41,6 +42,18 @@ POSE_AXES = ("x", "y", "Y")
 # The arguments the batch itself gives every launch file: the run is stepped by its scenario and seeded.
 BATCH_ARGS = ("lockstep", "seed")
 DEFAULT_TIMEOUT = 300.0
+# Bounds that keep a spec finishable: the driver holds one record per run (about 2 kB) and expands every run
+# before the first starts; retries are for runs that crashed, not for a run that always does; a run longer than a
+# day is a hang. Seeds and integer ROS parameters travel as XML-RPC's 32-bit integers.
+MAX_RUNS = 100_000
+MAX_RETRIES = 10
+MAX_TIMEOUT = 86_400.0
+MAX_SEED = 2**31 - 1
+XMLRPC_INT = (-2**31, 2**31 - 1)
+# Names that become folder names, Dask keys and parts of run ids.
+PLAIN_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+# A global ROS name as the batch sets it (a leading / is added): letters first in every part.
+ROS_NAME = re.compile(r"/?[A-Za-z]\w*(/[A-Za-z]\w*)*")
 
 
 class SpecError(ValueError):
@@ -189,18 +202,29 @@ def parse(data, path: str, resolve_launch: Resolver) -> Spec:
     scenarios_data = data["scenarios"]
     if not isinstance(scenarios_data, dict) or not scenarios_data:
         where.fail("scenarios", "must map at least one scenario name to its definition")
-    scenarios = {str(name): _scenario(str(name), definition, folder, where, resolve_launch)
+    scenarios = {_plain(name, f"scenarios.{name}", where): _scenario(str(name), definition, folder, where,
+                                                                      resolve_launch)
                  for name, definition in scenarios_data.items()}
     matrix = _matrix(data["matrix"], where)
+    setters = {}
     for key, values in matrix.items():
         for index, value in enumerate(values):
-            for target in (value if isinstance(value, dict) else {key: value}):
-                _check_target(target, scenarios, where, f"matrix.{key}" + (f"[{index}]" if target != key else ""))
-    return Spec(path=path, name=str(data.get("name") or os.path.splitext(os.path.basename(path))[0]),
-                scenarios=scenarios, matrix=matrix,
-                repetitions=_integer(data.get("repetitions", 1), "repetitions", 1, where),
-                timeout=_positive(data.get("timeout", DEFAULT_TIMEOUT), "timeout", where),
-                retries=_integer(data.get("retries", 0), "retries", 0, where))
+            for target, entry in (value if isinstance(value, dict) else {key: value}).items():
+                if isinstance(value, dict):
+                    target_key = value_key = f"matrix.{key}[{index}].{target}"
+                else:
+                    target_key, value_key = f"matrix.{key}", f"matrix.{key}[{index}]"
+                _check_target(target, entry, scenarios, where, target_key, value_key)
+                if setters.setdefault(target, key) != key:
+                    where.fail(target_key, f"sets {target}, which matrix.{setters[target]} sets too")
+    repetitions = _integer(data.get("repetitions", 1), "repetitions", 1, where, MAX_RUNS)
+    count = len(scenarios) * repetitions * math.prod(len(values) for values in matrix.values())
+    if count > MAX_RUNS:
+        where.fail("matrix", f"makes {count} runs, more than the {MAX_RUNS} a batch may hold")
+    name = data.get("name") or os.path.splitext(os.path.basename(path))[0]
+    return Spec(path=path, name=_plain(name, "name", where), scenarios=scenarios, matrix=matrix,
+                repetitions=repetitions, timeout=_positive(data.get("timeout", DEFAULT_TIMEOUT), "timeout", where),
+                retries=_integer(data.get("retries", 0), "retries", 0, where, MAX_RETRIES))
 
 
 class _Where:
@@ -259,9 +283,12 @@ def _scenario(name, definition, folder, where: _Where, resolve_launch: Resolver)
         if not isinstance(bounds, dict) or not bounds:
             where.fail(f"{key}.metrics.{metric}", "must be a mapping with min and/or max")
         where.known_keys(f"{key}.metrics.{metric}", bounds, CHECK_KEYS)
-        checks[str(metric)] = Check(*(None if bounds.get(bound) is None else
-                                      _finite(bounds[bound], f"{key}.metrics.{metric}.{bound}", where)
-                                      for bound in CHECK_KEYS))
+        check = Check(*(None if bounds.get(bound) is None else
+                        _finite(bounds[bound], f"{key}.metrics.{metric}.{bound}", where) for bound in CHECK_KEYS))
+        if check.minimum is not None and check.maximum is not None and check.minimum > check.maximum:
+            where.fail(f"{key}.metrics.{metric}", f"min {check.minimum:g} is above max {check.maximum:g}: "
+                                                  "no value can pass")
+        checks[str(metric)] = check
     written = {name: definition[name] for name in ("launch", "python", "rostest", "args") if name in definition}
     return Scenario(name=name, definition=written, launch_path=launch_path, python_path=python_path,
                     rostest_path=rostest_path, args={k: _arg_text(v) for k, v in args.items()}, checks=checks,
@@ -298,11 +325,17 @@ def _generated(generator: dict, key: str, where: _Where) -> list:
         bounds = options if isinstance(options, list) else [options]
         if not 1 <= len(bounds) <= 3 or not all(isinstance(b, int) and not isinstance(b, bool) for b in bounds):
             where.fail(f"{key}.range", "takes N, [START, STOP] or [START, STOP, STEP] (integers)")
-        return list(range(*bounds))
+        start, stop, step = (0, bounds[0], 1) if len(bounds) == 1 else (*bounds, 1)[:3]
+        if step == 0:
+            where.fail(f"{key}.range", "a step of 0 never reaches its stop")
+        # Counted before it is made: len() of a range past sys.maxsize raises.
+        if (stop - start + step - (1 if step > 0 else -1)) // step > MAX_RUNS:
+            where.fail(f"{key}.range", f"more than the {MAX_RUNS} runs a batch may hold")
+        return list(range(start, stop, step))
     if not isinstance(options, dict):
         where.fail(f"{key}.random_poses", "takes count, seed and [low, high] for x, y and Y")
     where.known_keys(f"{key}.random_poses", options, ("count", "seed") + POSE_AXES)
-    count = _integer(options.get("count"), f"{key}.random_poses.count", 1, where)
+    count = _integer(options.get("count"), f"{key}.random_poses.count", 1, where, MAX_RUNS)
     seed = _integer(options.get("seed", 0), f"{key}.random_poses.seed", 0, where)
     ranges = {}
     for axis in POSE_AXES:
@@ -321,8 +354,13 @@ def _generated(generator: dict, key: str, where: _Where) -> list:
             for _ in range(count)]
 
 
-def _check_target(target: str, scenarios: Dict[str, Scenario], where: _Where, key: str):
+def _check_target(target, value, scenarios: Dict[str, Scenario], where: _Where, key: str, value_key: str):
+    """``key`` names the target in the spec, ``value_key`` the value."""
+    if not isinstance(target, str):
+        where.fail(key, f"{target!r} is not a target's name (seed, args.NAME, params.NAME or a scenario parameter)")
     if target == "seed":
+        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_SEED:
+            where.fail(value_key, f"a seed must be an integer from 0 to {MAX_SEED}, not {value!r}")
         return
     if target.startswith("args."):
         name = target[len("args."):]
@@ -332,8 +370,17 @@ def _check_target(target: str, scenarios: Dict[str, Scenario], where: _Where, ke
             if name not in scenario.declared_args:
                 where.fail(key, f"scenario '{scenario.name}''s launch file has no argument '{name}' "
                                 f"(it takes {', '.join(scenario.declared_args)})")
-    elif target.startswith("params.") and len(target) == len("params."):
-        where.fail(key, "names no ROS parameter")
+    elif target.startswith("params."):
+        if not ROS_NAME.fullmatch(target[len("params."):]):
+            where.fail(key, f"'{target[len('params.'):]}' is not a ROS parameter name")
+        if isinstance(value, int) and not isinstance(value, bool) and not XMLRPC_INT[0] <= value <= XMLRPC_INT[1]:
+            where.fail(value_key, f"{value} does not fit a ROS parameter's 32-bit integer")
+
+
+def _plain(name, key: str, where: _Where) -> str:
+    if not isinstance(name, (str, int)) or isinstance(name, bool) or not PLAIN_NAME.fullmatch(str(name)):
+        where.fail(key, f"{name!r} is not a plain name (letters, digits, '_', '.' and '-'; it names folders)")
+    return str(name)
 
 
 def _text(value, key: str, where: _Where) -> str:
@@ -360,12 +407,14 @@ def _finite(value, key: str, where: _Where) -> float:
 
 def _positive(value, key: str, where: _Where) -> float:
     seconds = _finite(value, key, where)
-    if seconds <= 0:
-        where.fail(key, f"must be a positive number of seconds, not {value!r}")
+    if not 0 < seconds <= MAX_TIMEOUT:
+        where.fail(key, f"must be a positive number of seconds up to {MAX_TIMEOUT:g}, not {value!r}")
     return seconds
 
 
-def _integer(value, key: str, minimum: int, where: _Where) -> int:
+def _integer(value, key: str, minimum: int, where: _Where, maximum: int = None) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
         where.fail(key, f"must be an integer >= {minimum}, not {value!r}")
+    if maximum is not None and value > maximum:
+        where.fail(key, f"must be at most {maximum}, not {value}")
     return value

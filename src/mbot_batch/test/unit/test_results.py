@@ -77,3 +77,53 @@ def test_files_of_a_run_the_summary_and_the_report(tmp_path):
     assert page.count("<img") == 2 and "data:image/png;base64," in page
     assert "drive-2" in page and "distance = 0.25, wanted &gt;= 1" in page and "last line &lt;b&gt;" in page
     assert "2 of 3 runs finished: 1 failed, 1 passed" in page
+
+
+def strict_json(path):
+    """The file's JSON, refusing NaN and infinities as strict JSON does."""
+    def refuse(constant):
+        raise ValueError(f"{path}: {constant} is not strict JSON")
+    with open(path) as stream:
+        return json.load(stream, parse_constant=refuse)
+
+
+def test_a_metric_that_is_not_finite_fails_its_run_is_recorded_in_strict_json_and_listed_by_the_report(tmp_path):
+    from mbot_batch import engine
+    from mbot_batch.spec import Scenario, Spec
+    runs = [a_run("drive-1", 0, 0.1), a_run("drive-2", 1, 0.2), a_run("drive-3", 2, 0.3)]
+    spec = Spec(path="/s.yaml", name="drive", scenarios={"drive": Scenario("drive", {}, checks=CHECKS)}, matrix={},
+                repetitions=1, timeout=10.0, retries=0)
+    raws = [raw(metrics={"distance": 2.0, "y": float("inf")}), raw(metrics={"distance": float("nan"), "y": 1.0}),
+            raw(metrics={"distance": 1e308, "y": -1e999, "sim_time": float("inf")})]
+    records = {run.run_id: engine.result_record(run, each, spec, 1, {}) for run, each in zip(runs, raws)}
+    for run in runs:
+        results.write_result(str(tmp_path), run, records[run.run_id])
+    assert [(record["status"], record["reason"]) for record in records.values()] == [
+        ("failed", "y = inf, not a finite number"), ("failed", "distance = nan, wanted >= 1"),
+        ("failed", "y = -inf, not a finite number; sim_time = inf, not a finite number")]
+    stored = strict_json(tmp_path / "runs" / "drive-3" / "result.json")
+    assert stored["metrics"] == {"distance": 1e308, "y": "-inf", "sim_time": "inf"}
+    assert strict_json(tmp_path / "runs" / "drive-2" / "metrics.json") == {"distance": "nan", "y": 1.0}
+    assert stored == results.load_result(str(tmp_path), "drive-3")
+    # As the batch wrote them before: NaN and Infinity in result.json, read back as floats.
+    loaded = {run.run_id: results.load_result(str(tmp_path), run.run_id) for run in runs}
+    loaded["drive-1"]["metrics"]["y"] = float("inf")
+    for records_seen in (loaded, records):
+        page = report.page("drive", runs, records_seen)
+        assert page.count("<img") == 2
+        listed = page.split("Metrics not drawn (5)", 1)[1]
+        for run_id, name, value in (("drive-1", "y", "inf"), ("drive-2", "distance", "nan"),
+                                    ("drive-3", "distance", "1e+308"), ("drive-3", "y", "-inf"),
+                                    ("drive-3", "sim_time", "inf")):
+            assert f"<code>{run_id}</code></td><td>{name}</td><td>{value}</td>" in listed
+    results.write_summary(str(tmp_path / "summary.csv"), runs, records)
+    rows = list(csv.DictReader((tmp_path / "summary.csv").open()))
+    assert [row["y"] for row in rows] == ["inf", "1.0", "-inf"]
+
+
+def test_the_metric_figure_draws_extreme_finite_values():
+    """numpy's default bins fail on these (a span of 5e-324, one value of 1e300, a span past the largest float)."""
+    for values in ([0.0, 5e-324], [1e300, 1e300], [-1e300, 1e300], [3.0], [1.0, 1.0 + 2.0 ** -52], [-7.0, 2.0]):
+        runs = [a_run(f"drive-{index}", index, 0.1) for index in range(len(values))]
+        records = {run.run_id: finished(run, raw(metrics={"distance": value})) for run, value in zip(runs, values)}
+        assert report.page("drive", runs, records).count("<img") == 2, values

@@ -108,6 +108,26 @@ def test_random_poses_are_seeded_and_within_their_ranges(write):
     (("pkg good.launch", "pkg noseed.launch"), "scenarios.drive: noseed.launch declares no 'seed' argument"),
     (("    python: scenario.py", "    rostest: pkg good.launch"), "scenarios.drive.launch: a rostest scenario"),
     (("speed: [0.1, 0.2]", "speed: {random: 3}"), "matrix.speed: a mapping of values must be one generator"),
+    # Specs that could not finish or could not pass.
+    (("seed: {range: 3}", "seed: {range: 100000000}"), "matrix.seed.range: more than the 100000 runs"),
+    (("seed: {range: 3}", "seed: {range: [0, 100000000000000000000000]}"), "matrix.seed.range: more than"),
+    (("seed: {range: 3}", "seed: {range: [0, 10, 0]}"), "matrix.seed.range: a step of 0"),
+    (("seed: {range: 3}", "seed: {range: 400}\n  other: {range: 400}"), "matrix: makes 320000 runs, more than"),
+    (("retries: 2", "retries: 1000000000"), "retries: must be at most 10"),
+    (("timeout: 30", "timeout: 1.0e+300"), "timeout: must be a positive number of seconds up to 86400"),
+    (("seed: {range: 3}", "seed: [abc]"), "matrix.seed[0]: a seed must be an integer from 0 to 2147483647"),
+    (("seed: {range: 3}", "seed: [1, 2.5]"), "matrix.seed[1]: a seed must be an integer"),
+    (("seed: {range: 3}", "seed: [-1]"), "matrix.seed[0]: a seed must be an integer"),
+    (("seed: {range: 3}", "seed: [4294967296]"), "matrix.seed[0]: a seed must be an integer"),
+    (("speed: [0.1, 0.2]", "start: [{seed: x}]"), "matrix.start[0].seed: a seed must be an integer"),
+    (("{distance: {min: 1.0}}", "{x: {min: 5, max: 1}}"), "scenarios.drive.metrics.x: min 5 is above max 1"),
+    # Names that become folders, keys and ROS names.
+    (("scenarios:\n  drive:", "name: ../../etc\nscenarios:\n  drive:"), "name: '../../etc' is not a plain name"),
+    (("scenarios:\n  drive:", "scenarios:\n  a/b:"), "scenarios.a/b: 'a/b' is not a plain name"),
+    (("speed: [0.1, 0.2]", "params.a b: [1]"), "matrix.params.a b: 'a b' is not a ROS parameter name"),
+    (("speed: [0.1, 0.2]", "params.x: [4294967296]"), "matrix.params.x[0]: 4294967296 does not fit"),
+    (("speed: [0.1, 0.2]", "start: [{1: 2}]"), "matrix.start[0].1: 1 is not a target's name"),
+    (("speed: [0.1, 0.2]", "speed: [0.1]\n  pair: [{speed: 0.3}]"), "matrix.pair[0].speed: sets speed, which"),
 ])
 def test_bad_specs_are_refused_with_one_line_naming_the_key(write, change, key):
     with pytest.raises(SpecError) as error:
