@@ -62,12 +62,13 @@ def test_running_controllers_hold_the_new_positions_instead_of_pulling_back(arm)
     assert positions(spawned) == pytest.approx(POSE, abs=5e-3)
 
 
-def test_a_position_joint_without_a_controller_stays_where_it_was_set(arm):
-    sim, spawned, plugin = arm
-    sim.set_model_configuration("robot", ["wrist_3_joint"], [0.4])
+def test_a_joint_without_a_controller_stays_where_it_was_set_under_gravity(arm):
+    """The shoulder set to -1.2 rad, where gravity pulls the arm down: a position joint's command is its new
+    position, and an effort joint no controller drives is held there too (unheld, it falls to -1.94 rad in 0.5 s)."""
+    sim, spawned, _ = arm
+    sim.set_model_configuration("robot", ["shoulder_lift_joint"], [-1.2])
     sim.step(500)
-    if plugin.hw.joints["wrist_3_joint"].interface == "position":
-        assert positions(spawned, ["wrist_3_joint"]) == pytest.approx([0.4], abs=1e-3)
+    assert positions(spawned, ["shoulder_lift_joint"]) == pytest.approx([-1.2], abs=1e-3)
 
 
 @pytest.mark.parametrize("names, values, message", [

@@ -65,6 +65,23 @@ def test_prediction_moves_along_the_heading_and_grows_the_covariance():
     assert np.all(np.diag(ekf.covariance) > np.diag(before))
 
 
+def test_a_one_member_correction_takes_the_kalman_gain_of_its_closed_form():
+    """x measured alone with variance r against the prior's p: gain k = p / (p + r), the state moves k of the way
+    to the measurement and the variance becomes (1 - k) p; the unmeasured members stay."""
+    ekf = Ekf()
+    p, r, prior, measured = 0.4, 0.1, 1.0, 2.0
+    ekf.covariance = np.eye(STATE_SIZE) * 0.3
+    ekf.covariance[X, X] = p
+    ekf.state[X], ekf.state[VX] = prior, 0.7
+    values, covariance = np.zeros(STATE_SIZE), np.eye(STATE_SIZE) * r
+    values[X] = measured
+    ekf.correct(Measurement("odom0", 1.0, values, covariance, members(X)))
+    gain = p / (p + r)
+    assert ekf.state[X] == pytest.approx(prior + gain * (measured - prior), abs=1e-12)
+    assert ekf.covariance[X, X] == pytest.approx((1 - gain) * p, abs=1e-12)
+    assert ekf.state[VX] == 0.7 and ekf.covariance[VX, VX] == 0.3
+
+
 def test_tf2_euler_conventions():
     rotation = rpy_matrix(0.1, -0.2, 2.5)
     assert np.allclose(matrix_rpy(rotation), (0.1, -0.2, 2.5))
