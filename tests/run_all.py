@@ -24,14 +24,14 @@ WORKERS = 2 * (os.cpu_count() or 1)
 # junit classname (its path, dotted) has; rostest files, wherever they are, count as "rostest". The budgets are
 # printed against what the run measured, never enforced: a timed test on a shared machine would flake.
 AREAS = (
-    ("simulator", ("src.mbot_sim_bridge.",), 75),
-    ("batch", ("src.mbot_batch.",), 50),
-    ("course", ("src.mbot_gazebo.", "src.mbot_teleop.", "src.mbot_description."), 25),
-    ("integration", ("tests.integration.",), 110),
-    ("docs and style", ("tests.unit.",), 30),
-    ("stand-ins", ("src.",), 45),
+    ("simulator", ("src.mbot_sim_bridge.",), 40),
+    ("batch", ("src.mbot_batch.",), 40),
+    ("course", ("src.mbot_gazebo.", "src.mbot_teleop.", "src.mbot_description."), 12),
+    ("integration", ("tests.integration.",), 130),
+    ("docs and style", ("tests.unit.",), 6),
+    ("stand-ins", ("src.",), 12),
 )
-ROSTEST_BUDGET_SECONDS = 100
+ROSTEST_BUDGET_SECONDS = 75
 
 
 def area_of(classname, is_rostest):
