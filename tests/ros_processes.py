@@ -64,3 +64,29 @@ def call_service(environment, service, request="{}", timeout=60):
         else:
             os.environ["ROS_MASTER_URI"] = saved
     return yaml.safe_load(genpy.message.strify_message(response))
+
+
+def processes_named(marker):
+    """Live processes whose command line has ``marker`` as one of its words (found without their environment)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{entry}/cmdline", "rb") as stream:
+                named = marker.encode() in stream.read().split(b"\0")
+            with open(f"/proc/{entry}/stat") as stream:
+                alive = stream.read().rsplit(")", 1)[1].split()[0] != "Z"
+        except (OSError, IndexError):
+            continue  # not a process, or gone
+        if named and alive:
+            found.append(int(entry))
+    return found
+
+
+def folder_bytes(folder):
+    """Every file under ``folder``, by its path relative to it, with its bytes."""
+    files = {}
+    for root, _, names in os.walk(folder):
+        for name in names:
+            with open(os.path.join(root, name), "rb") as stream:
+                files[os.path.relpath(os.path.join(root, name), folder)] = stream.read()
+    return files

@@ -29,7 +29,7 @@ import pytest
 from mbot_batch.engine import folder_token
 from mbot_batch.results import load_result
 from mbot_batch.run import processes_with_token
-from ros_processes import wait_until
+from ros_processes import folder_bytes, processes_named, wait_until
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios"))
 from hang import HOSTILE_CHILDREN  # noqa: E402 - the scenarios' folder is no package
@@ -73,32 +73,6 @@ def assert_no_run_processes(out, timeout=3.0):
                interval=SCAN_INTERVAL)
 
 
-def processes_named(marker):
-    """Live processes whose command line holds ``marker`` (found without their environment)."""
-    found = []
-    for entry in os.listdir("/proc"):
-        try:
-            with open(f"/proc/{entry}/cmdline", "rb") as stream:
-                named = marker.encode() in stream.read().split(b"\0")
-            with open(f"/proc/{entry}/stat") as stream:
-                alive = stream.read().rsplit(")", 1)[1].split()[0] != "Z"
-        except (OSError, IndexError):
-            continue  # not a process, or gone
-        if named and alive:
-            found.append(int(entry))
-    return found
-
-
-def snapshot(folder):
-    """Every file under ``folder`` with its bytes."""
-    files = {}
-    for root, _, names in os.walk(folder):
-        for name in names:
-            with open(os.path.join(root, name), "rb") as stream:
-                files[os.path.relpath(os.path.join(root, name), folder)] = stream.read()
-    return files
-
-
 def scheduling_policies(pids):
     policies = set()
     for pid in pids:
@@ -137,11 +111,11 @@ def embedded(tmp_path_factory):
                    interval=SCAN_INTERVAL)
         seen["policies"] = scheduling_policies(processes_with_token(folder_token(out)))
         # A second batch into the same folder meanwhile: refused before it writes anything.
-        before = {name: data for name, data in snapshot(out).items() if not name.startswith("runs")}
+        before = {name: data for name, data in folder_bytes(out).items() if not name.startswith("runs")}
         second = subprocess.run([sys.executable, BATCH, SPEC, "-o", out, "--quiet"], capture_output=True, text=True,
                                 timeout=60)
         seen["second batch"] = (second.returncode, second.stderr, before,
-                                {name: data for name, data in snapshot(out).items() if not name.startswith("runs")})
+                                {name: data for name, data in folder_bytes(out).items() if not name.startswith("runs")})
         interrupted = time.monotonic()
         os.killpg(driver.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the driver and its workers
         seen["ctrl-c exit"] = driver.wait(timeout=30)

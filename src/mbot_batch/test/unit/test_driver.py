@@ -8,6 +8,7 @@ import sys
 
 import pytest
 from mbot_batch import cli, engine, launch_files, report, results, spec
+from ros_processes import folder_bytes
 
 FULL_SWEEP = bool(os.environ.get("MBOT_FULL_SWEEP"))
 SPEC = """\
@@ -42,16 +43,7 @@ def finished_batch(tmp_path, monkeypatch):
                                         "attempts": 1, "wall_seconds": 1.0, "sim_seconds": 1.0, "worker": "w",
                                         "log_tail": ""})
     assert cli.main([str(path), "-o", out, "--quiet"]) == 1
-    return str(path), out, files(out)
-
-
-def files(folder):
-    found = {}
-    for root, _, names in os.walk(folder):
-        for name in names:
-            with open(os.path.join(root, name), "rb") as stream:
-                found[os.path.relpath(os.path.join(root, name), folder)] = stream.read()
-    return found
+    return str(path), out, folder_bytes(out)
 
 
 def interrupt(*_, **__):
@@ -75,7 +67,7 @@ def test_ctrl_c_at_any_phase_exits_130_and_leaves_every_file_whole(finished_batc
         pytest.fail(f"Ctrl-C in {name} ended the batch with a raw KeyboardInterrupt")
     assert status == 130
     assert "Traceback" not in capsys.readouterr().err
-    after = files(out)
+    after = folder_bytes(out)
     assert after.pop(engine.LOCK_FILE, b"").startswith(b"pid ")  # who held it last
     assert after == {name: data for name, data in before.items() if name != engine.LOCK_FILE}  # nothing cut short
 
@@ -92,7 +84,7 @@ def test_a_second_batch_into_a_folder_in_use_is_refused_and_a_killed_holder_leav
         message = capsys.readouterr().err
         assert re.fullmatch(rf"mbot batch: {re.escape(out)} is in use by another batch \(pid {holder.pid} on "
                             r".+ since .+\): wait for it to end, or give another -o\n", message), message
-        after = files(out)
+        after = folder_bytes(out)
         assert after.pop(engine.LOCK_FILE).startswith(f"pid {holder.pid} ".encode())
         assert after == {name: data for name, data in before.items() if name != engine.LOCK_FILE}
     finally:
@@ -119,7 +111,7 @@ def test_concurrent_batches_into_one_folder_are_refused_or_finish_with_every_res
         assert any(status == 1 for status, _ in outcomes), outcomes
         for status, message in outcomes:
             assert status == 1 and message == "" or status == 2 and "is in use by another batch" in message, outcomes
-        after = files(out)
+        after = folder_bytes(out)
         assert {name: data for name, data in after.items() if name != engine.LOCK_FILE} == \
             {name: data for name, data in before.items() if name != engine.LOCK_FILE}
     print(f"figure: batch: concurrent drivers into one folder: {len(outcomes)} started, "

@@ -8,7 +8,7 @@ import uuid
 
 import pytest
 from mbot_batch import engine, results, run
-from ros_processes import wait_until
+from ros_processes import processes_named, wait_until
 
 SCENARIOS = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "scenarios")
 sys.path.insert(0, SCENARIOS)
@@ -30,21 +30,6 @@ if sys.stdin.readline().strip() == "own":
     sys.exit(0)
 time.sleep(1000)
 """
-
-
-def processes_named(marker):
-    found = []
-    for entry in os.listdir("/proc"):
-        try:
-            with open(f"/proc/{entry}/cmdline", "rb") as stream:
-                named = marker.encode() in stream.read().split(b"\0")
-            with open(f"/proc/{entry}/stat") as stream:
-                alive = stream.read().rsplit(")", 1)[1].split()[0] != "Z"
-        except (OSError, IndexError):
-            continue
-        if named and alive:
-            found.append(int(entry))
-    return found
 
 
 @pytest.mark.parametrize("killer", ["its run process", "the driver"])
