@@ -2,12 +2,13 @@
 down on its target with less than 5 mm of slip in the fingers, held by friction alone, then with
 libgazebo_ros_link_attacher.so (in the pick world) attaching it while the fingers hold it, then with
 libgazebo_grasp_fix.so in the arm's description attaching it when the fingers grip and releasing it when they
-open."""
+open. Once attached, the fingers open off the box for the carry: the attachment alone must hold it."""
 from arm_pick import arm_with_box, pick, placement_error, step_until
+from ros_control_fixtures import run_until_ended
 
 from mbot_sim_bridge.core.manipulation.grasp_fix import GraspFix
 from mbot_sim_bridge.core.manipulation.link_attacher import LinkAttacher
-from mbot_sim_bridge.core.ros_control.gripper_action_controller import ABORTED
+from mbot_sim_bridge.core.ros_control.gripper_action_controller import ABORTED, SUCCEEDED, GripperGoal
 
 MAX_SLIP = 0.005  # m
 # The gripper's Gazebo link: gripper_base_link hangs on tool0 and wrist_3_link by fixed joints, lumped into it.
@@ -21,6 +22,17 @@ GRASP_FIX = """<gazebo><plugin name="gazebo_grasp_fix" filename="libgazebo_grasp
   <grip_count_threshold>4</grip_count_threshold><max_grip_count>8</max_grip_count>
   <release_tolerance>0.005</release_tolerance><disable_collisions_on_attach>false</disable_collisions_on_attach>
 </plugin></gazebo>"""
+
+
+# Each finger 3 mm off the 4 cm box's face: no contact, so no friction, yet less than the grasp fix's
+# release_tolerance (5 mm), which would release the box.
+LOOSENED = 0.023  # m from the centre line
+
+
+def loosen_fingers(sim, gripper):
+    assert gripper.accept_goal(GripperGoal(LOOSENED, 20.0))
+    outcome = run_until_ended(sim, gripper)
+    assert (outcome.status, outcome.reached_goal) == (SUCCEEDED, True), outcome
 
 
 def assert_held_and_placed(sim, record, grasp: str):
@@ -48,7 +60,11 @@ def test_the_link_attacher_holds_the_box_from_closing_to_opening():
         attacher, = sim.world_plugins.plugins
         assert isinstance(attacher, LinkAttacher)
         answers = []
-        record = pick(sim, spawned, arm, gripper, after_close=lambda: answers.append(attacher.attach(GRIPPER_LINK)),
+
+        def attach():
+            answers.append(attacher.attach(GRIPPER_LINK))
+            loosen_fingers(sim, gripper)
+        record = pick(sim, spawned, arm, gripper, after_close=attach,
                       before_release=lambda: answers.append(attacher.detach(GRIPPER_LINK)))
         assert answers == [(True, "Attach finished."), (True, "")]
         assert_held_and_placed(sim, record, "link attacher grasp")
@@ -62,8 +78,11 @@ def test_the_grasp_fix_attaches_the_gripped_box_and_releases_it_when_the_fingers
     try:
         fix = next(plugin for plugin in spawned.plugins if isinstance(plugin, GraspFix))
         holders = []
-        record = pick(sim, spawned, arm, gripper,
-                      after_close=lambda: step_until(sim, lambda: fix.attached, 1.0, "the grasp fix's attachment"),
+
+        def attached():
+            step_until(sim, lambda: fix.attached, 1.0, "the grasp fix's attachment")
+            loosen_fingers(sim, gripper)
+        record = pick(sim, spawned, arm, gripper, after_close=attached,
                       before_release=lambda: holders.append({box: holder for box, (holder, _) in fix.attached.items()}),
                       after_release=lambda: step_until(sim, lambda: not fix.attached, 1.0, "its release"))
         assert holders == [{("box", "link"): "arm"}]  # held all the way
