@@ -23,13 +23,13 @@ from .description.mesh import with_pybullet_readable_meshes
 from .description.robot_model import RobotModel
 from .description.world_description import PhysicsConfig
 from .wheel_contact import WheelContacts, wheel
+from .xml_values import MAX_POSITION
 from .world_bodies import LoadedWorld
 
 _logger = get_logger(__name__)
 
 # Beyond these a body is lost to the simulation (Bullet's broadphase and solver overflow or lose all precision),
-# so poses and velocities given from outside are refused past them.
-MAX_POSITION = 1.0e5  # m
+# so poses and velocities given from outside are refused past them; MAX_POSITION (m) bounds descriptions too.
 MAX_SPEED = 1.0e4  # m/s and rad/s
 # SDF's <surface><contact><ode><max_vel> when a link sets none (URDF <maxVel>): with the world's
 # contact_max_correcting_vel, the most velocity Gazebo's ODE leaves a link with from undoing a penetration.

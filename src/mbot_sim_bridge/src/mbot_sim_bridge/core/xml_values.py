@@ -24,11 +24,11 @@ MAX_DEPTH = 100
 # while it reads: at 1.7 million (a 48 MB model) each scan stopped every thread, the loop too, for up to 2 s.
 MAX_DOCUMENT_BYTES = 64 << 20
 MAX_ELEMENTS = 250_000
-# The farthest a pose or origin may place anything (m), as far as a model may be placed (engine.MAX_POSITION):
-# a link at 1e308 m overflowed the lumped inertia ("Eigenvalues did not converge").
-MAX_OFFSET = 1.0e5
-# The largest size of a shape (m), as far: a box of 1e308 m was frozen and deleted within 10 ms of its spawn.
-MAX_SHAPE_SIZE = 1.0e5
+# The farthest anything may be placed (m), by a pose, an origin or a service, and the largest size of a shape:
+# beyond it Bullet's broadphase and solver overflow or lose all precision (a link at 1e308 m overflowed the lumped
+# inertia, "Eigenvalues did not converge"; a box of 1e308 m was frozen and deleted within 10 ms of its spawn).
+MAX_POSITION = 1.0e5
+MAX_SHAPE_SIZE = MAX_POSITION
 
 
 class XmlDocument(NamedTuple):
@@ -210,9 +210,9 @@ def read_pose(element: Optional[ET.Element], document: XmlDocument) -> Pose:
 
 
 def _check_offset(position: Sequence[float], document: XmlDocument, element: ET.Element, name: str):
-    if max(abs(value) for value in position) > MAX_OFFSET:
+    if max(abs(value) for value in position) > MAX_POSITION:
         raise document.fail(element, f"{name}: position {' '.join(f'{value:g}' for value in position)} is beyond "
-                                     f"±{MAX_OFFSET:g} m")
+                                     f"±{MAX_POSITION:g} m")
 
 
 def read_bool(element: Optional[ET.Element], document: XmlDocument, default: bool = False) -> bool:
